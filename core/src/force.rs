@@ -1,0 +1,181 @@
+//! External forces (M5.1, eqs. 4-6): `v <- v + dt F / m`, with `F` the sum of
+//! the terms the description enables. A uniform acceleration is the same for
+//! every mass; the other terms are forces, divided by the particle's mass.
+
+use crate::desc::{finite, Boundary, Vortex};
+use crate::world::World;
+use crate::Error;
+
+/// The force terms of one step, read-only, for the general force path.
+pub(crate) struct ForceTerms<'a> {
+    pub gravity: [f32; 3],
+    pub field: Option<&'a [f32]>,
+    pub potential: Option<&'a [f32]>,
+    pub vortex: Option<Vortex>,
+    pub n: [usize; 3],
+    pub periodic: [bool; 3],
+    pub dim: usize,
+}
+
+impl ForceTerms<'_> {
+    /// Acceleration of a particle of mass `m` at cell `pos` (dense index
+    /// `cell`).
+    #[inline]
+    pub fn accel(&self, pos: [usize; 3], cell: usize, m: f32) -> [f32; 3] {
+        let mut f = [0.0f32; 3];
+        if let Some(field) = self.field {
+            for k in 0..self.dim {
+                f[k] += field[cell * self.dim + k];
+            }
+        }
+        if let Some(u) = self.potential {
+            let g = self.grad(u, pos, cell);
+            for k in 0..self.dim {
+                f[k] -= g[k]; // eq. 6: F = -grad U
+            }
+        }
+        if let Some(v) = self.vortex {
+            let t = vortex_force(&v, [pos[0] as f32 + 0.5, pos[1] as f32 + 0.5]);
+            f[0] += t[0];
+            f[1] += t[1];
+        }
+        let mut a = self.gravity;
+        for k in 0..self.dim {
+            a[k] += f[k] / m;
+        }
+        a
+    }
+
+    /// Central differences of `u` (eq. 6) on the grid; one-sided at a face
+    /// that is not periodic.
+    fn grad(&self, u: &[f32], pos: [usize; 3], cell: usize) -> [f32; 3] {
+        let mut g = [0.0f32; 3];
+        let mut stride = 1usize;
+        for k in 0..self.dim {
+            let n = self.n[k];
+            let x = pos[k];
+            let lo_in = x > 0 || self.periodic[k];
+            let hi_in = x + 1 < n || self.periodic[k];
+            let lo = if x > 0 { cell - stride } else { cell + (n - 1) * stride };
+            let hi = if x + 1 < n { cell + stride } else { cell - (n - 1) * stride };
+            g[k] = match (lo_in, hi_in) {
+                (true, true) => 0.5 * (u[hi] - u[lo]),
+                (false, true) => u[hi] - u[cell],
+                (true, false) => u[cell] - u[lo],
+                (false, false) => 0.0, // an axis of one cell has no gradient
+            };
+            stride *= n;
+        }
+        g
+    }
+}
+
+/// The static Rankine vortex force at point `p`: tangential, of magnitude
+/// `G/(2 pi) * r/R^2` inside the core and `G/(2 pi r)` outside, which is
+/// `G/(2 pi) * (-dy, dx) / max(r^2, R^2)`: no square root needed.
+#[inline]
+pub(crate) fn vortex_force(v: &Vortex, p: [f32; 2]) -> [f32; 2] {
+    let dx = p[0] - v.centre[0];
+    let dy = p[1] - v.centre[1];
+    let r2 = (dx * dx + dy * dy).max(v.core_radius * v.core_radius);
+    let s = v.circulation / (core::f32::consts::TAU * r2);
+    [-dy * s, dx * s]
+}
+
+impl World {
+    fn force_plane_check(&self, enabled: bool, values: &[f32], per_cell: usize) -> Result<(), Error> {
+        if !enabled {
+            return Err(Error::NotEnabled);
+        }
+        if values.len() != self.layout().cells * per_cell {
+            return Err(Error::BadLength);
+        }
+        finite(values)
+    }
+
+    /// Sets the uniform acceleration (M5.1). Needs `forces.uniform`.
+    pub fn set_gravity(&mut self, g: [f32; 3]) -> Result<(), Error> {
+        if !self.head.desc.forces.uniform {
+            return Err(Error::NotEnabled);
+        }
+        finite(&g)?;
+        self.head.desc.gravity = g;
+        if self.dim() == 2 {
+            self.head.desc.gravity[2] = 0.0;
+        }
+        Ok(())
+    }
+
+    /// Sets the Rankine vortex. Needs `forces.vortex`.
+    pub fn set_vortex(&mut self, v: Vortex) -> Result<(), Error> {
+        if !self.head.desc.forces.vortex {
+            return Err(Error::NotEnabled);
+        }
+        finite(&[v.centre[0], v.centre[1], v.core_radius, v.circulation])?;
+        if v.core_radius <= 0.0 {
+            return Err(Error::BadVortex);
+        }
+        self.head.desc.vortex = v;
+        Ok(())
+    }
+
+    /// Replaces the per-cell force field: `dim` components per cell, cells in
+    /// dense order (x fastest). Needs `forces.field`.
+    pub fn set_force_field(&mut self, forces: &[f32]) -> Result<(), Error> {
+        self.force_plane_check(self.head.desc.forces.field, forces, self.dim())?;
+        self.planes::<u8>().1.field.copy_from_slice(forces);
+        Ok(())
+    }
+
+    /// Sets the force on one cell. Needs `forces.field`.
+    pub fn set_cell_force(&mut self, pos: [u32; 3], f: [f32; 3]) -> Result<(), Error> {
+        let s = self.locate(pos)?;
+        if !self.head.desc.forces.field {
+            return Err(Error::NotEnabled);
+        }
+        finite(&f)?;
+        let d = self.dim();
+        self.planes::<u8>().1.field[s.cell * d..s.cell * d + d].copy_from_slice(&f[..d]);
+        Ok(())
+    }
+
+    /// Replaces the potential: one value per cell, dense order. Needs
+    /// `forces.potential`.
+    pub fn set_potential(&mut self, u: &[f32]) -> Result<(), Error> {
+        self.force_plane_check(self.head.desc.forces.potential, u, 1)?;
+        self.planes::<u8>().1.potential.copy_from_slice(u);
+        Ok(())
+    }
+
+    /// Sets the potential of one cell. Needs `forces.potential`.
+    pub fn set_cell_potential(&mut self, pos: [u32; 3], u: f32) -> Result<(), Error> {
+        let s = self.locate(pos)?;
+        if !self.head.desc.forces.potential {
+            return Err(Error::NotEnabled);
+        }
+        finite(&[u])?;
+        self.planes::<u8>().1.potential[s.cell] = u;
+        Ok(())
+    }
+
+    pub(crate) fn periodic(&self) -> [bool; 3] {
+        let b = self.head.desc.boundary;
+        [0, 1, 2].map(|k| b[k][0] == Boundary::Periodic)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rankine_profile() {
+        let v = Vortex { centre: [0.0, 0.0], core_radius: 2.0, circulation: core::f32::consts::TAU };
+        // Inside the core: |F| = r / R^2; outside: 1 / r; tangential, CCW.
+        let f = vortex_force(&v, [1.0, 0.0]);
+        assert!((f[0]).abs() < 1e-7 && (f[1] - 0.25).abs() < 1e-6);
+        let f = vortex_force(&v, [0.0, 4.0]);
+        assert!((f[0] + 0.25).abs() < 1e-6 && f[1].abs() < 1e-7);
+        assert_eq!(vortex_force(&v, [0.0, 0.0]), [0.0, 0.0]);
+    }
+}
