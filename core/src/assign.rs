@@ -96,6 +96,10 @@ pub fn cost(problem: &MoveProblem, assignment: &Assignment) -> (u32, u32) {
 
 /// Solve one block: D is 2 or 3.
 ///
+/// Draws from `rng` only to break ties: exact-fast at most once, exhaustive
+/// once per optimal leaf after the first, greedy once per particle that has
+/// several equally good cells.
+///
 /// The preconditions (`count` at most the number of free cells, current
 /// cells distinct, free and inside the block, desired cells inside the
 /// block) are checked in debug builds only. A release build given a block
@@ -268,7 +272,9 @@ fn exhaustive<R: Rng + ?Sized>(
     if count > 0 {
         search.descend(0, 0, 0);
     }
-    Assignment { target: search.kept }
+    Assignment {
+        target: search.kept,
+    }
 }
 
 // ---------------------------------------------------------- exact, subsets
@@ -316,20 +322,17 @@ const fn completions(free: u8, count: usize, costs: &MoveCosts) -> Completions {
         cost: [0; 1 << MAX_CELLS],
         ways: [0; 1 << MAX_CELLS],
     };
-    // Every particle placed: nothing left to pay, one way to finish.
-    let mut n = SIZE_START[count];
-    while n < SIZE_START[count + 1] {
-        let mask = SUBSETS_BY_SIZE[n];
-        n += 1;
-        if mask & !free == 0 {
-            out.ways[mask as usize] = 1;
-        }
+    if count == 0 {
+        out.ways[0] = 1;
+        return out;
     }
     // Smaller sets after larger ones, so every child is done before its
-    // parent; the particle to place next is the `placed`-th.
+    // parent; the particle to place next is the `placed`-th. Children of the
+    // last particle are complete: nothing left to pay, one way to finish.
     let mut placed = count;
     while placed > 0 {
         placed -= 1;
+        let last = placed + 1 == count;
         let row = &costs[placed];
         let mut n = SIZE_START[placed];
         while n < SIZE_START[placed + 1] {
@@ -345,12 +348,17 @@ const fn completions(free: u8, count: usize, costs: &MoveCosts) -> Completions {
                 let cell = open.trailing_zeros() as usize;
                 open &= open - 1;
                 let child = mask as usize | 1 << cell;
-                let total = row[cell] as u16 + out.cost[child];
+                let (rest, finishes) = if last {
+                    (0, 1)
+                } else {
+                    (out.cost[child], out.ways[child])
+                };
+                let total = row[cell] as u16 + rest;
                 // Masks, not branches: which child wins is data, and a
                 // mispredicted branch costs more than this whole step.
                 let tie = 0u16.wrapping_sub((total == best) as u16);
                 let wins = 0u16.wrapping_sub((total <= best) as u16);
-                ways = (ways & !wins) | (((ways & tie) + out.ways[child]) & wins);
+                ways = (ways & !wins) | (((ways & tie) + finishes) & wins);
                 best ^= (best ^ total) & wins;
             }
             out.cost[mask as usize] = best;
@@ -382,8 +390,12 @@ const fn nth_optimal(
             let cell = open.trailing_zeros() as usize;
             open &= open - 1;
             let child = mask | 1 << cell;
-            if costs[i][cell] as u16 + done.cost[child as usize] == goal {
-                let ways = done.ways[child as usize];
+            let (rest, ways) = if i + 1 == count {
+                (0, 1)
+            } else {
+                (done.cost[child as usize], done.ways[child as usize])
+            };
+            if costs[i][cell] as u16 + rest == goal {
                 if rank < ways {
                     target[i] = cell as u8;
                     mask = child;
@@ -406,8 +418,14 @@ fn exact_subsets<R: Rng + ?Sized>(
     let costs = move_costs(problem, count);
     let done = completions(free, count, &costs);
     let total = done.ways[0];
-    let rank = if total > 1 { below(rng, u32::from(total)) as u16 } else { 0 };
-    Assignment { target: nth_optimal(free, count, &costs, &done, rank) }
+    let rank = if total > 1 {
+        below(rng, u32::from(total)) as u16
+    } else {
+        0
+    };
+    Assignment {
+        target: nth_optimal(free, count, &costs, &done, rank),
+    }
 }
 
 // ------------------------------------------------------------ exact, 2D table
@@ -504,7 +522,10 @@ struct Entry {
 /// Every optimal assignment of every 2D block state (M5.6), built by the
 /// compiler with the same dynamic programme as 3D.
 const fn build_table_2d() -> [Entry; KEYS_2D] {
-    let mut table = [Entry { count: 0, moves: [0; MAX_TIES_2D] }; KEYS_2D];
+    let mut table = [Entry {
+        count: 0,
+        moves: [0; MAX_TIES_2D],
+    }; KEYS_2D];
     let mut key = 0;
     while key < KEYS_2D {
         if let Some(block) = decode_key(key) {
@@ -539,9 +560,9 @@ fn exact_table_2d<R: Rng + ?Sized>(
     rng: &mut R,
 ) -> Assignment {
     let entry = &TABLE_2D[table_key(problem, free, count)];
+    // A count of 0 is a key no block has: only malformed input gets there.
     let pick = match entry.count {
-        0 => 0, // no block has this key; only malformed input gets here
-        1 => 0,
+        0 | 1 => 0,
         n => below(rng, u32::from(n)) as usize,
     };
     let packed = entry.moves.get(pick).copied().unwrap_or(0);
@@ -556,7 +577,12 @@ fn exact_table_2d<R: Rng + ?Sized>(
 
 // --------------------------------------------------------------------- greedy
 
-fn greedy<R: Rng + ?Sized>(problem: &MoveProblem, free: u8, count: usize, rng: &mut R) -> Assignment {
+fn greedy<R: Rng + ?Sized>(
+    problem: &MoveProblem,
+    free: u8,
+    count: usize,
+    rng: &mut R,
+) -> Assignment {
     // Fastest first; a stable insertion sort keeps equal speeds in problem
     // order (and a NaN speed where it is).
     let mut order = [0usize; MAX_CELLS];
@@ -589,7 +615,11 @@ fn greedy<R: Rng + ?Sized>(problem: &MoveProblem, free: u8, count: usize, rng: &
                 ties += 1;
             }
         }
-        let pick = if ties > 1 { below(rng, ties as u32) as usize } else { 0 };
+        let pick = if ties > 1 {
+            below(rng, ties as u32) as usize
+        } else {
+            0
+        };
         let cell = tied[pick];
         assignment.target[i] = cell;
         taken |= 1 << cell;
@@ -665,14 +695,21 @@ mod tests {
     /// Every ordering of `0..n`.
     fn permutations(n: usize) -> Vec<Vec<usize>> {
         (0..n.pow(n as u32))
-            .map(|code| (0..n).map(|k| code / n.pow(k as u32) % n).collect::<Vec<_>>())
+            .map(|code| {
+                (0..n)
+                    .map(|k| code / n.pow(k as u32) % n)
+                    .collect::<Vec<_>>()
+            })
             .filter(|p| (0..n).all(|k| p.contains(&k)))
             .collect()
     }
 
     /// Runs all three methods on one block and checks them against each
     /// other; returns the exhaustive cost.
-    fn check_block<const D: usize>(problem: &MoveProblem, rng: &mut crate::rng::Stream) -> (u32, u32) {
+    fn check_block<const D: usize>(
+        problem: &MoveProblem,
+        rng: &mut crate::rng::Stream,
+    ) -> (u32, u32) {
         let cells = 1 << D;
         let exhaustive = assign_moves::<D, _>(Method::Exhaustive, problem, rng);
         let fast = assign_moves::<D, _>(Method::ExactFast, problem, rng);
@@ -695,7 +732,9 @@ mod tests {
         let mut rng = block_stream(1, 0, 0);
         let mut states = 0;
         for key in 0..KEYS_2D {
-            let Some(mut block) = decode_key(key) else { continue };
+            let Some(mut block) = decode_key(key) else {
+                continue;
+            };
             states += 1;
             for i in 0..block.count {
                 block.speed2[i] = (rng.next_u32() % 3) as f32; // ties included
@@ -713,7 +752,8 @@ mod tests {
     fn table_2d_lists_every_optimal_assignment_once() {
         // Expect: each table entry holds exactly the brute-force set of
         // optimal assignments, each once (so a uniform pick from it is a
-        // uniform tie-break), and the longest list is MAX_TIES_2D long.
+        // uniform tie-break), and the longest list is MAX_TIES_2D long: 5, as
+        // an independent brute force over the 1296 states also finds.
         let mut most = 0;
         for (key, entry) in TABLE_2D.iter().enumerate() {
             let Some(block) = decode_key(key) else {
@@ -732,6 +772,7 @@ mod tests {
             most = most.max(listed.len());
         }
         assert_eq!(most, MAX_TIES_2D);
+        assert_eq!(MAX_TIES_2D, 5);
     }
 
     /// A random 3D block: `count` particles on distinct cells, random wishes
@@ -741,7 +782,10 @@ mod tests {
         for i in (1..MAX_CELLS).rev() {
             cells.swap(i, below(rng, i as u32 + 1) as usize);
         }
-        let mut problem = MoveProblem { count, ..MoveProblem::default() };
+        let mut problem = MoveProblem {
+            count,
+            ..MoveProblem::default()
+        };
         for (i, &cell) in cells.iter().enumerate() {
             if i < count {
                 problem.current[i] = cell;
@@ -777,18 +821,25 @@ mod tests {
         }
     }
 
-    /// Draws `per_tie` times the number of optimal assignments from `method`
-    /// and checks each optimal assignment's frequency against the binomial.
-    fn check_uniform<const D: usize>(method: Method, problem: &MoveProblem, seed: u64) {
+    /// Checks that `problem` has `ties` optimal assignments, draws 3,000
+    /// times that many from `method`, and checks each optimal assignment's
+    /// frequency against the binomial.
+    fn check_uniform<const D: usize>(
+        method: Method,
+        problem: &MoveProblem,
+        ties: usize,
+        seed: u64,
+    ) {
         let (_, optimal) = optimal_set(problem, 1 << D);
-        let ties = optimal.len();
-        assert!(ties >= 2, "not a tie: {problem:?}");
+        assert_eq!(optimal.len(), ties, "{problem:?}");
         let draws = 3_000 * ties;
         let mut hits = std::vec![0u32; ties];
         let mut rng = block_stream(seed, 0, 0);
         for _ in 0..draws {
             let a = assign_moves::<D, _>(method, problem, &mut rng);
-            let k = optimal.iter().position(|o| o.target[..problem.count] == a.target[..problem.count]);
+            let k = optimal
+                .iter()
+                .position(|o| o.target[..problem.count] == a.target[..problem.count]);
             hits[k.expect("drew a non-optimal assignment")] += 1;
         }
         // Each count is binomial(draws, 1/ties); 5 sd bands fail by chance
@@ -797,12 +848,19 @@ mod tests {
         let mean = draws as f64 * p;
         let sd = (draws as f64 * p * (1.0 - p)).sqrt();
         for &h in &hits {
-            assert!((f64::from(h) - mean).abs() < 5.0 * sd, "{method:?} {problem:?}: {hits:?}");
+            assert!(
+                (f64::from(h) - mean).abs() < 5.0 * sd,
+                "{method:?} {problem:?}: {hits:?}"
+            );
         }
     }
 
     fn block(free: u8, current: &[u8], desired: &[u8]) -> MoveProblem {
-        let mut problem = MoveProblem { free, count: current.len(), ..MoveProblem::default() };
+        let mut problem = MoveProblem {
+            free,
+            count: current.len(),
+            ..MoveProblem::default()
+        };
         problem.current[..current.len()].copy_from_slice(current);
         problem.desired[..desired.len()].copy_from_slice(desired);
         problem
@@ -813,23 +871,26 @@ mod tests {
         // Expect: where several assignments are optimal, exact-fast and
         // exhaustive pick each with equal frequency, within 5 binomial sd.
         // 2D: cells 1 and 2 both want the empty cell 0 (2 optimal: one moves
-        // in, the other stays), and the first block with the most ties.
+        // in, the other stays), and the first block with the most ties (5).
         let pair_2d = block(0b1111, &[1, 2], &[0, 0]);
-        let key = (0..KEYS_2D).find(|&k| usize::from(TABLE_2D[k].count) == MAX_TIES_2D).unwrap();
+        let key = (0..KEYS_2D)
+            .find(|&k| usize::from(TABLE_2D[k].count) == MAX_TIES_2D)
+            .unwrap();
         let most_2d = decode_key(key).unwrap();
         // 3D: cells 1, 2, 4 all want the empty cell 0 (3 optimal: one moves
         // in); cells 1, 2, 4 all want the far cell 7 (9 optimal: one moves
         // in, the others to distinct cells next to 7); cells 6, 0, 5, 3 all
-        // want cell 7.
+        // want cell 7 (4 optimal: the far particle from 0 ends in 7, or in
+        // the cell of a neighbour of 7 that moves into 7).
         let three_3d = block(0xff, &[1, 2, 4], &[0, 0, 0]);
         let mixed_3d = block(0xff, &[1, 2, 4], &[7, 7, 7]);
         let even_3d = block(0xff, &[6, 0, 5, 3], &[7, 7, 7, 7]);
         for method in [Method::ExactFast, Method::Exhaustive] {
-            check_uniform::<2>(method, &pair_2d, 10);
-            check_uniform::<2>(method, &most_2d, 11);
-            check_uniform::<3>(method, &three_3d, 12);
-            check_uniform::<3>(method, &mixed_3d, 13);
-            check_uniform::<3>(method, &even_3d, 14);
+            check_uniform::<2>(method, &pair_2d, 2, 10);
+            check_uniform::<2>(method, &most_2d, MAX_TIES_2D, 11);
+            check_uniform::<3>(method, &three_3d, 3, 12);
+            check_uniform::<3>(method, &mixed_3d, 9, 13);
+            check_uniform::<3>(method, &even_3d, 4, 14);
         }
     }
 
@@ -845,16 +906,25 @@ mod tests {
         for method in [Method::Exhaustive, Method::ExactFast, Method::Greedy] {
             for cell in 0..4 {
                 let lone = block(0b1111, &[cell], &[cell]);
-                assert_eq!(assign_moves::<2, _>(method, &lone, &mut rng).target[0], cell);
+                assert_eq!(
+                    assign_moves::<2, _>(method, &lone, &mut rng).target[0],
+                    cell
+                );
             }
             for cell in 0..8 {
                 let lone = block(0xff, &[cell], &[cell]);
-                assert_eq!(assign_moves::<3, _>(method, &lone, &mut rng).target[0], cell);
+                assert_eq!(
+                    assign_moves::<3, _>(method, &lone, &mut rng).target[0],
+                    cell
+                );
             }
         }
         let pair = block(0b1111, &[0, 1], &[1, 1]);
         for method in [Method::Exhaustive, Method::ExactFast] {
-            assert_eq!(assign_moves::<2, _>(method, &pair, &mut rng).target[..2], [0, 1]);
+            assert_eq!(
+                assign_moves::<2, _>(method, &pair, &mut rng).target[..2],
+                [0, 1]
+            );
         }
     }
 

@@ -4,7 +4,8 @@
 //! times (set `MPCA_BENCH_RUNS`, default 5) and prints the median wall time
 //! with the spread, nanoseconds per processed block, the share of blocks
 //! skipped as empty, bytes per cell and the paper's time. Timing is of the
-//! steps alone, not of building the world.
+//! steps alone, not of building the world. `MPCA_BENCH_SCENE=water` (say)
+//! runs one scene only, e.g. under `valgrind --tool=callgrind`.
 
 use std::time::Instant;
 
@@ -17,8 +18,9 @@ fn main() {
         "{:<12} {:>4} {:>9} {:>9} {:>6} {:>11} {:>15} {:>10} {:>9} {:>7} {:>12}",
         "scene", "sec", "cells", "particles", "steps", "median_ms", "min..max_ms", "ns/block", "skipped", "B/cell", "paper_s"
     );
+    let only = std::env::var("MPCA_BENCH_SCENE").ok();
     let mut memory = Vec::new();
-    for scene in paper_scenes() {
+    for scene in paper_scenes().into_iter().filter(|s| only.as_deref().is_none_or(|n| n == s.name)) {
         let mut times = Vec::with_capacity(runs);
         let (mut processed, mut total) = (0u64, 0u64);
         let mut particles = 0;
