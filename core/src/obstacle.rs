@@ -24,6 +24,10 @@ pub struct Surface {
     pub normal: [f32; 3],
     /// Restitution `e` of eq. 9.
     pub restitution: f32,
+    /// 1 where the normal is M7's free-neighbour normal of a mask, which is
+    /// recomputed when obstacles are added next to the cell; 0 where it was
+    /// given or came from a shape's geometry.
+    pub from_mask: u32,
 }
 
 // SAFETY: u32 and f32 fields, no padding, every bit pattern valid.
@@ -71,10 +75,10 @@ pub(crate) fn normalise(v: [f32; 3]) -> Option<[f32; 3]> {
     (len.is_finite() && len > 1e-6).then(|| [v[0] / len, v[1] / len, v[2] / len])
 }
 
-/// Eq. 9: `v' = v - (1 + e)(N.v)N`. Applied only to a particle moving into
-/// the surface (`N.v < 0`); one already moving away along `N` keeps its
-/// velocity, since eq. 9 would turn it back into the obstacle. Either way the
-/// particle stays this step (M5.4).
+/// Eq. 9: `v' = v - (1 + e)(N.v)N`, for a particle moving into the surface
+/// (`N.v < 0`; the step makes sure of that by choosing `N`). A particle
+/// moving away along `N` is returned unchanged, never turned back into the
+/// obstacle.
 #[inline]
 pub(crate) fn reflect(v: [f32; 3], n: [f32; 3], e: f32) -> [f32; 3] {
     let vn = dot(v, n);
@@ -193,7 +197,7 @@ impl Shape {
     }
 
     /// Cells whose centres may lie inside, per axis `lo..hi`.
-    fn bounds(&self, n: [usize; 3]) -> ([usize; 3], [usize; 3]) {
+    fn bounds(&self, n: [usize; 3], dim: usize) -> ([usize; 3], [usize; 3]) {
         let (lo, hi): ([f32; 3], [f32; 3]) = match *self {
             Shape::HalfSpace { .. } => return ([0; 3], n),
             Shape::Box { min, max } => (min, max),
@@ -202,9 +206,10 @@ impl Shape {
             }
             Shape::Sphere { centre, radius } => (centre.map(|c| c - radius), centre.map(|c| c + radius)),
         };
+        // Axes the world does not have span their single cell.
         let mut a = [0usize; 3];
-        let mut b = [1usize; 3];
-        for k in 0..3 {
+        let mut b = n;
+        for k in 0..dim {
             // Centre i + 0.5 >= lo  <=>  i >= lo - 0.5; float-to-int casts
             // saturate, so huge shapes are clipped to the world.
             a[k] = (libm::floorf(lo[k] - 0.5).max(0.0) as usize).min(n[k]);
@@ -274,10 +279,65 @@ impl World {
         }
     }
 
+    /// Whether cell `c` has a free neighbour once the cells for which
+    /// `obstacle` holds are obstacles.
+    fn is_surface(&self, c: [usize; 3], obstacle: Mask<'_>) -> bool {
+        let mut free = false;
+        self.for_neighbours(|off| free |= self.free_after(c, off, obstacle));
+        free
+    }
+
+    /// M7's normal for an arbitrary mask: the sum of the unit directions to
+    /// the free neighbours (not normalised; zero where it is undefined).
+    fn mask_normal(&self, c: [usize; 3], obstacle: Mask<'_>) -> [f32; 3] {
+        let mut sum = [0.0f32; 3];
+        self.for_neighbours(|off| {
+            if self.free_after(c, off, obstacle) {
+                let d = normalise(off.map(|o| o as f32)).unwrap_or([0.0; 3]);
+                for k in 0..3 {
+                    sum[k] += d[k];
+                }
+            }
+        });
+        sum
+    }
+
+    fn surfaces_used(&self) -> &[Surface] {
+        &self.plane::<Surface>(self.layout().surface)[..self.head.surfaces as usize]
+    }
+
+    /// Inserts or replaces the entry of `entry.cell`; the caller checked that
+    /// the table has room.
+    fn put_surface(&mut self, entry: Surface) {
+        let (head, p) = self.planes::<u8>();
+        let used = head.surfaces as usize;
+        match p.surface[..used].binary_search_by_key(&entry.cell, |t| t.cell) {
+            Ok(i) => p.surface[i] = entry,
+            Err(i) => {
+                p.surface.copy_within(i..used, i + 1);
+                p.surface[i] = entry;
+                head.surfaces += 1;
+            }
+        }
+    }
+
+    fn drop_surface(&mut self, cell: u32) {
+        let (head, p) = self.planes::<u8>();
+        let used = head.surfaces as usize;
+        if let Ok(i) = p.surface[..used].binary_search_by_key(&cell, |t| t.cell) {
+            p.surface.copy_within(i + 1..used, i);
+            head.surfaces -= 1;
+        }
+    }
+
     /// Adds the cells in `lo..hi` for which `inside` holds as obstacles of
-    /// restitution `e`; `normal` gives each surface cell's outward normal
-    /// (normalised here). Two passes: the first checks everything and counts
-    /// new surface entries, the second writes.
+    /// restitution `e`; `normal` gives each new surface cell's outward normal
+    /// (normalised here), `from_mask` says it is M7's free-neighbour normal.
+    ///
+    /// Existing obstacle cells next to the new ones are kept up to date: an
+    /// entry whose cell no longer has a free neighbour is dropped, and a
+    /// free-neighbour normal is computed again. Two passes: the first checks
+    /// everything against the obstacles as they will be, the second writes.
     fn add_obstacles(
         &mut self,
         lo: [usize; 3],
@@ -285,24 +345,14 @@ impl World {
         e: f32,
         inside: Mask<'_>,
         normal: NormalFn<'_>,
+        from_mask: bool,
     ) -> Result<(), Error> {
         if !self.head.desc.obstacles {
             return Err(Error::NotEnabled);
         }
         restitution(e)?;
         let l = *self.layout();
-        let obstacle_after = |w: &World, c: [usize; 3]| {
-            w.is_obstacle(l.site(c[0], c[1], c[2])) || inside(c)
-        };
-        let surface_normal = |w: &World, c: [usize; 3]| -> Result<Option<[f32; 3]>, Error> {
-            let after = |nb| obstacle_after(w, nb);
-            let mut free = false;
-            w.for_neighbours(|off| free |= w.free_after(c, off, &after));
-            if !free {
-                return Ok(None);
-            }
-            normalise(normal(w, c, &|nb| obstacle_after(w, nb))).map(Some).ok_or(Error::UndefinedNormal)
-        };
+        let site = |c: [usize; 3]| l.site(c[0], c[1], c[2]);
         let each = |f: &mut dyn FnMut([usize; 3]) -> Result<(), Error>| -> Result<(), Error> {
             for z in lo[2]..hi[2] {
                 for y in lo[1]..hi[1] {
@@ -315,49 +365,86 @@ impl World {
             }
             Ok(())
         };
-        let used = self.head.surfaces as usize;
+        // Existing obstacle cells next to new cell `c`, outside the new set.
+        let old_neighbours = |w: &World, c: [usize; 3], f: &mut dyn FnMut([usize; 3]) -> Result<(), Error>| {
+            let mut result = Ok(());
+            w.for_neighbours(|off| {
+                if let (Ok(()), Beyond::Inside(nb)) = (result, w.beyond(c, off)) {
+                    if w.is_obstacle(site(nb)) && !inside(nb) {
+                        result = f(nb);
+                    }
+                }
+            });
+            result
+        };
+
+        // Pass 1: check, and count the entries to add.
         let mut new_entries = 0usize;
         {
-            let table: &[Surface] = &self.plane::<Surface>(l.surface)[..used];
             let w: &World = self;
+            let after = |c: [usize; 3]| w.is_obstacle(site(c)) || inside(c);
+            let table = w.surfaces_used();
             each(&mut |c| {
-                let s = l.site(c[0], c[1], c[2]);
-                if w.occupied(s) {
+                if w.occupied(site(c)) {
                     return Err(Error::CellOccupied);
                 }
-                if surface_normal(w, c)?.is_some() && surface_at(table, s.cell as u32).is_none() {
-                    new_entries += 1;
+                if w.is_surface(c, &after) {
+                    normalise(normal(w, c, &after)).ok_or(Error::UndefinedNormal)?;
+                    new_entries += usize::from(surface_at(table, site(c).cell as u32).is_none());
                 }
-                Ok(())
+                old_neighbours(w, c, &mut |nb| {
+                    let old = surface_at(table, site(nb).cell as u32);
+                    if old.is_some_and(|s| s.from_mask != 0) && w.is_surface(nb, &after) {
+                        normalise(w.mask_normal(nb, &after)).ok_or(Error::UndefinedNormal)?;
+                    }
+                    Ok(())
+                })
             })?;
         }
         let capacity = l.surface.len / core::mem::size_of::<Surface>();
-        if used + new_entries > capacity {
+        if self.head.surfaces as usize + new_entries > capacity {
             return Err(Error::SurfaceTableFull);
         }
-        // Pass 2: normals first (they read the plane as it will be), then
-        // the bits. Cannot fail: pass 1 checked every cell.
-        let mut count = used;
+
+        // Pass 2: the bits, then the entries, read off the plane as it now is.
+        // Nothing here can fail: pass 1 checked every cell.
         each(&mut |c| {
-            let s = l.site(c[0], c[1], c[2]);
-            if let Ok(Some(n)) = surface_normal(self, c) {
-                let (head, p) = self.planes::<u8>();
-                let entry = Surface { cell: s.cell as u32, normal: n, restitution: e };
-                match p.surface[..count].binary_search_by_key(&entry.cell, |t| t.cell) {
-                    Ok(i) => p.surface[i] = entry,
-                    Err(i) => {
-                        p.surface.copy_within(i..count, i + 1);
-                        p.surface[i] = entry;
-                        count += 1;
-                        head.surfaces = count as u32;
-                    }
-                }
-            }
+            put_bit(self.planes::<u8>().1.obstacle, site(c).bit, true);
             Ok(())
         })?;
         each(&mut |c| {
-            let s = l.site(c[0], c[1], c[2]);
-            put_bit(self.planes::<u8>().1.obstacle, s.bit, true);
+            let w: &World = self;
+            let plane = |q: [usize; 3]| w.is_obstacle(site(q));
+            let cell = site(c).cell as u32;
+            let entry = w
+                .is_surface(c, &plane)
+                .then(|| normalise(normal(w, c, &plane)))
+                .flatten()
+                .map(|n| Surface { cell, normal: n, restitution: e, from_mask: u32::from(from_mask) });
+            match entry {
+                Some(entry) => self.put_surface(entry),
+                None => self.drop_surface(cell),
+            }
+            let mut stale = [[0usize; 3]; 26];
+            let mut count = 0;
+            let _ = old_neighbours(self, c, &mut |nb| {
+                stale[count] = nb;
+                count += 1;
+                Ok(())
+            });
+            for &nb in &stale[..count] {
+                let w: &World = self;
+                let plane = |q: [usize; 3]| w.is_obstacle(site(q));
+                let cell = site(nb).cell as u32;
+                let Some(old) = surface_at(w.surfaces_used(), cell).copied() else { continue };
+                if !w.is_surface(nb, &plane) {
+                    self.drop_surface(cell);
+                } else if old.from_mask != 0 {
+                    if let Some(n) = normalise(w.mask_normal(nb, &plane)) {
+                        self.put_surface(Surface { normal: n, ..old });
+                    }
+                }
+            }
             Ok(())
         })
     }
@@ -372,9 +459,9 @@ impl World {
             nrm[2] = 0.0;
         }
         normalise(nrm).ok_or(Error::UndefinedNormal)?;
-        let c = pos.map(|v| v as usize);
         let _ = s;
-        self.add_obstacles(c, c.map(|v| v + 1), e, &|q| q == c, &|_, _, _| nrm)
+        let c = pos.map(|v| v as usize);
+        self.add_obstacles(c, c.map(|v| v + 1), e, &|q| q == c, &|_, _, _| nrm, false)
     }
 
     /// Adds a shape's cells as obstacles with restitution `e`, normals from
@@ -382,8 +469,9 @@ impl World {
     pub fn add_shape(&mut self, shape: Shape, e: f32) -> Result<(), Error> {
         let dim = self.dim();
         shape.check(dim)?;
-        let (lo, hi) = shape.bounds(self.layout().n);
-        self.add_obstacles(lo, hi, e, &|c| shape.contains(centre(c), dim), &|_, c, _| shape.normal(centre(c), dim))
+        let (lo, hi) = shape.bounds(self.layout().n, dim);
+        let normal = |_: &World, c, _: Mask<'_>| shape.normal(centre(c), dim);
+        self.add_obstacles(lo, hi, e, &|c| shape.contains(centre(c), dim), &normal, false)
     }
 
     /// Adds every cell whose byte in `mask` (one per cell, x fastest) is not
@@ -397,19 +485,8 @@ impl World {
             return Err(Error::BadLength);
         }
         let inside = |c: [usize; 3]| mask[l.site(c[0], c[1], c[2]).cell] != 0;
-        let normal = |w: &World, c: [usize; 3], obstacle_after: Mask<'_>| {
-            let mut sum = [0.0f32; 3];
-            w.for_neighbours(|off| {
-                if w.free_after(c, off, obstacle_after) {
-                    let d = normalise(off.map(|o| o as f32)).unwrap_or([0.0; 3]);
-                    for k in 0..3 {
-                        sum[k] += d[k];
-                    }
-                }
-            });
-            sum
-        };
-        self.add_obstacles([0; 3], l.n, e, &inside, &normal)
+        let normal = |w: &World, c, obstacle: Mask<'_>| w.mask_normal(c, obstacle);
+        self.add_obstacles([0; 3], l.n, e, &inside, &normal, true)
     }
 
     /// Whether `pos` is an obstacle (false outside the world).

@@ -17,11 +17,11 @@ pub(crate) trait Quant: Copy + Default + crate::world::Plain + 'static {
         self.to_int() as f32 * (1.0 / Self::SCALE)
     }
 
-    /// Round to nearest: for velocities a caller sets, which need no stream.
+    /// Round to nearest, halves away from zero so that `v` and `-v` store
+    /// opposite values: for velocities a caller sets, which need no stream.
     #[inline]
     fn nearest(v: f32) -> Self {
-        let x = (v.clamp(-1.0, 1.0) * Self::SCALE) + 0.5;
-        Self::from_int(libm::floorf(x) as i32)
+        Self::from_int(libm::roundf(v.clamp(-1.0, 1.0) * Self::SCALE) as i32)
     }
 
     /// Unbiased stochastic rounding of `x`, a velocity component in quanta

@@ -248,6 +248,11 @@ impl<Q: Quant, const D: usize, const OBST: bool, const FORCE: u8, const MASS: bo
                 } else {
                     (b.wall_normal[want], self.desc.wall_restitution)
                 };
+                // A normal that does not face the incoming particle (a
+                // half-space seen across a periodic seam, a mask corner) would
+                // leave it pressing on the obstacle for ever: reflect off the
+                // face it came through instead.
+                let n = if dot(b.v[c], n) < 0.0 { n } else { back_normal::<D>(c, want) };
                 b.v[c] = reflect(b.v[c], n, e); // eq. 9
                 let m = b.mass[c];
                 self.clamp(&mut b.v[c], m);
