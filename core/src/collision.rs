@@ -80,19 +80,37 @@ pub(crate) fn collide_pair(va: [f32; 3], vb: [f32; 3], ma: f32, mb: f32, e: f32,
 }
 
 /// M5.5: scales `v` back to `|v| = 1` if it is longer, returning the kinetic
-/// energy that removed for mass `m` (0 if nothing changed).
+/// energy that removed for mass `m` (`None` if nothing changed).
+///
+/// A velocity that overflowed `f32` (a force of 1e30 over a mass of 1e-30)
+/// keeps its direction: infinite components become unit ones and finite
+/// ones vanish beside them; a component left undefined (`inf - inf`) counts
+/// as zero. The energy removed is then reported as infinite.
 #[inline]
 pub(crate) fn clamp(v: &mut [f32; 3], m: f32) -> Option<f64> {
     let s2 = dot(*v, *v);
-    if s2 > 1.0 {
-        let inv = 1.0 / libm::sqrtf(s2);
-        for c in v.iter_mut() {
-            *c *= inv;
-        }
-        Some(0.5 * f64::from(m) * (f64::from(s2) - 1.0))
-    } else {
-        None
+    if s2 <= 1.0 {
+        return None;
     }
+    if !s2.is_finite() {
+        let big = v.iter().filter(|c| !c.is_nan()).fold(0.0f32, |b, c| b.max(c.abs()));
+        for c in v.iter_mut() {
+            *c = if c.is_nan() || big == 0.0 {
+                0.0
+            } else if big.is_infinite() {
+                if c.is_infinite() { c.signum() } else { 0.0 }
+            } else {
+                *c / big
+            };
+        }
+        let _ = clamp(v, m);
+        return Some(f64::INFINITY);
+    }
+    let inv = 1.0 / libm::sqrtf(s2);
+    for c in v.iter_mut() {
+        *c *= inv;
+    }
+    Some(0.5 * f64::from(m) * (f64::from(s2) - 1.0))
 }
 
 #[cfg(test)]
@@ -146,6 +164,25 @@ mod tests {
         for _ in 0..1000 {
             for r in [random_unit::<2, _>(&mut rng), random_unit::<3, _>(&mut rng)] {
                 assert!((dot(r, r) - 1.0).abs() < 1e-5);
+            }
+        }
+    }
+
+    #[test]
+    fn clamp_survives_overflow() {
+        // Expectation: a finite unit vector along the overflowing direction,
+        // zero where the direction is undefined, and infinite energy removed.
+        for (v, want) in [
+            ([f32::INFINITY, 1.0, 0.0], [1.0, 0.0, 0.0]),
+            ([f32::NEG_INFINITY, f32::INFINITY, 0.0], [-core::f32::consts::FRAC_1_SQRT_2, core::f32::consts::FRAC_1_SQRT_2, 0.0]),
+            ([3e38, 3e38, 0.0], [core::f32::consts::FRAC_1_SQRT_2, core::f32::consts::FRAC_1_SQRT_2, 0.0]),
+            ([f32::NAN, 0.0, 2.0], [0.0, 0.0, 1.0]),
+            ([f32::NAN, f32::NAN, f32::NAN], [0.0, 0.0, 0.0]),
+        ] {
+            let mut u = v;
+            assert_eq!(clamp(&mut u, 1.0), Some(f64::INFINITY), "{v:?}");
+            for k in 0..3 {
+                assert!((u[k] - want[k]).abs() < 1e-6, "{v:?} -> {u:?}");
             }
         }
     }
