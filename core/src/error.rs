@@ -72,6 +72,10 @@ pub enum Error {
     BadLength,
     /// The memory does not hold a world (wrong tag, destroyed or forged).
     NotAWorld,
+    /// The world lives in caller memory; only the caller can free it.
+    NotOwned,
+    /// The allocator refused the memory.
+    OutOfMemory,
 }
 
 impl Error {
@@ -109,6 +113,8 @@ impl Error {
             Error::BadResolution => "the output resolution or buffer length is wrong",
             Error::BadLength => "a per-cell input has the wrong length",
             Error::NotAWorld => "the memory does not hold a live world",
+            Error::NotOwned => "the world lives in caller memory; the caller frees it",
+            Error::OutOfMemory => "the allocator refused the memory",
         }
     }
 }

@@ -44,6 +44,8 @@ mod emitter;
 mod error;
 mod force;
 mod obstacle;
+#[cfg(feature = "alloc")]
+mod owned;
 mod partition;
 mod quant;
 pub mod rng;
@@ -55,6 +57,8 @@ pub use desc::{Boundary, Description, Drift, Forces, Quantization, Vortex};
 pub use emitter::Emitter;
 pub use error::Error;
 pub use obstacle::{Shape, Surface};
+#[cfg(feature = "alloc")]
+pub use owned::WorldBox;
 pub use step::Order;
 pub use world::{world_bytes, Cell, Particle, Particles, Stats, World, WORLD_ALIGN};
 

@@ -81,6 +81,8 @@ pub(crate) struct Header {
     pub masses: u32,
     pub surfaces: u32,
     pub emitters: u32,
+    /// 1 when the library allocated the memory ([`crate::WorldBox`]).
+    pub owned: u32,
 }
 
 const TAG: u64 = 0x6d70_6361_776f_726c; // "mpcaworl"
@@ -265,6 +267,7 @@ impl World {
             masses: 0,
             surfaces: 0,
             emitters: 0,
+            owned: 0,
         };
         // SAFETY: `base` is aligned for Header (pad above) and the region
         // holds size_of::<Header>() + layout.total bytes, borrowed for 'a.
@@ -316,6 +319,17 @@ impl World {
     /// [`World::from_ptr`] on it is refused.
     pub fn retire(&mut self) {
         self.head.tag = 0;
+    }
+
+    /// Whether the library allocated this world's memory (a
+    /// [`crate::WorldBox`]), so that it, not the caller, must free it.
+    pub fn is_owned(&self) -> bool {
+        self.head.owned != 0
+    }
+
+    /// Bytes from the world's start to the end of its planes.
+    pub fn size_in_bytes(&self) -> usize {
+        size_of::<Header>() + self.head.len
     }
 
     /// The description the world was built from.

@@ -1,0 +1,252 @@
+//! `mpca_desc`: the scene description (M9), as C sees it.
+
+use mpca_core::{Boundary, Description, Drift, Forces, Method, Quantization, Vortex};
+
+use crate::{check_size, flag, guard, mpca_status, read, write};
+
+/// What happens at one face of the domain (M4). Values of `mpca_desc.boundary`.
+#[repr(u32)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum mpca_boundary {
+    /// Wrap around to the opposite face; set it on both faces of the axis.
+    Periodic = 0,
+    /// An obstacle beyond the face, with the wall restitution.
+    Wall = 1,
+    /// Particles leave and are counted as exited.
+    Open = 2,
+}
+
+/// The move probability rule (M5.3). Values of `mpca_desc.drift`.
+#[repr(u32)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum mpca_drift {
+    /// The paper's p = |v|; a free particle drifts at p/(2-p).
+    Paper = 0,
+    /// p = 2|v|/(1+|v|); a free particle drifts at |v|.
+    Calibrated = 1,
+}
+
+/// The move assignment method (M5.6). Values of `mpca_desc.method`.
+#[repr(u32)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum mpca_method {
+    /// Every permutation: the paper's method, the reference.
+    Exhaustive = 0,
+    /// Always the exhaustive optimum, far faster.
+    ExactFast = 1,
+    /// The paper's 3D approximation: fastest particles choose first.
+    Greedy = 2,
+}
+
+/// Bits of `mpca_desc.forces` (M5.1); the force is the sum of those set.
+#[repr(u32)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum mpca_force {
+    /// A uniform acceleration (gravity), `mpca_desc.gravity`.
+    Uniform = 1,
+    /// A force per cell: mpca_world_set_force_field.
+    Field = 2,
+    /// A potential per cell, F = -grad U: mpca_world_set_potential.
+    Potential = 4,
+    /// The static Rankine vortex, `mpca_desc.vortex_*`.
+    Vortex = 8,
+}
+
+/// A scene description. Fill it with mpca_desc_defaults, then change the
+/// fields the scene needs. Flags are 0 or 1.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct mpca_desc {
+    /// `sizeof(mpca_desc)`; set by mpca_desc_defaults.
+    pub struct_size: u32,
+    /// 2 or 3.
+    pub dim: u32,
+    /// The seed of every random stream.
+    pub seed: u64,
+    /// Cells per axis, each even and at least 2; the third is ignored in 2D.
+    pub size: [u32; 3],
+    /// Per axis, the low and the high face: `mpca_boundary` values.
+    pub boundary: [[u32; 2]; 3],
+    /// The mass of every particle, or of those added without one.
+    pub mass: f32,
+    /// 1: particles carry their own masses (a table of `mass_classes`).
+    pub per_particle_mass: u32,
+    /// Capacity of the mass table, 1 to 256.
+    pub mass_classes: u32,
+    /// 1: the world has obstacles.
+    pub obstacles: u32,
+    /// How many obstacle surface cells fit.
+    pub surface_capacity: u32,
+    /// `mpca_force` bits.
+    pub forces: u32,
+    /// The uniform acceleration.
+    pub gravity: [f32; 3],
+    /// Vortex centre, in cells.
+    pub vortex_centre: [f32; 2],
+    /// Vortex core radius, in cells, greater than zero.
+    pub vortex_core_radius: f32,
+    /// Vortex circulation; its sign sets the sense of rotation.
+    pub vortex_circulation: f32,
+    /// Particle-particle restitution, in [0, 1].
+    pub restitution: f32,
+    /// Restitution of wall faces, in [0, 1].
+    pub wall_restitution: f32,
+    /// Time step, finite and not negative.
+    pub dt: f32,
+    /// Bits per stored velocity component: 8 or 16.
+    pub quantization: u32,
+    /// An `mpca_drift` value.
+    pub drift: u32,
+    /// An `mpca_method` value.
+    pub method: u32,
+    /// How many emitters fit.
+    pub emitter_capacity: u32,
+    /// 1: particles carry a lifetime, so emitters can give them one.
+    pub lifetimes: u32,
+}
+
+const FORCE_BITS: u32 = mpca_force::Uniform as u32 | mpca_force::Field as u32 | mpca_force::Potential as u32 | mpca_force::Vortex as u32;
+
+fn boundary_to_c(b: Boundary) -> u32 {
+    match b {
+        Boundary::Periodic => mpca_boundary::Periodic as u32,
+        Boundary::Wall => mpca_boundary::Wall as u32,
+        Boundary::Open => mpca_boundary::Open as u32,
+    }
+}
+
+fn boundary_from_c(v: u32) -> Result<Boundary, mpca_status> {
+    Ok(match v {
+        0 => Boundary::Periodic,
+        1 => Boundary::Wall,
+        2 => Boundary::Open,
+        _ => return Err(mpca_status::BadEnum),
+    })
+}
+
+impl mpca_desc {
+    pub(crate) fn from_core(d: &Description) -> mpca_desc {
+        let f = d.forces;
+        mpca_desc {
+            struct_size: core::mem::size_of::<mpca_desc>() as u32,
+            dim: d.dim,
+            seed: d.seed,
+            size: d.size,
+            boundary: d.boundary.map(|a| a.map(boundary_to_c)),
+            mass: d.mass,
+            per_particle_mass: u32::from(d.per_particle_mass),
+            mass_classes: d.mass_classes,
+            obstacles: u32::from(d.obstacles),
+            surface_capacity: d.surface_capacity,
+            forces: [
+                (f.uniform, mpca_force::Uniform),
+                (f.field, mpca_force::Field),
+                (f.potential, mpca_force::Potential),
+                (f.vortex, mpca_force::Vortex),
+            ]
+            .iter()
+            .filter(|(on, _)| *on)
+            .fold(0, |bits, (_, bit)| bits | *bit as u32),
+            gravity: d.gravity,
+            vortex_centre: d.vortex.centre,
+            vortex_core_radius: d.vortex.core_radius,
+            vortex_circulation: d.vortex.circulation,
+            restitution: d.restitution,
+            wall_restitution: d.wall_restitution,
+            dt: d.dt,
+            quantization: d.quantization as u32,
+            drift: d.drift as u32,
+            method: d.method as u32,
+            emitter_capacity: d.emitter_capacity,
+            lifetimes: u32::from(d.lifetimes),
+        }
+    }
+
+    /// The core description; unknown enum values and flags are refused
+    /// here, everything else by the core's own validation.
+    pub(crate) fn to_core(self) -> Result<Description, mpca_status> {
+        check_size::<mpca_desc>(self.struct_size)?;
+        if self.forces & !FORCE_BITS != 0 {
+            return Err(mpca_status::BadEnum);
+        }
+        let mut d = if self.dim == 3 { Description::new_3d(1, 1, 1) } else { Description::new_2d(1, 1) };
+        d.dim = self.dim;
+        d.seed = self.seed;
+        d.size = self.size;
+        for k in 0..3 {
+            for f in 0..2 {
+                d.boundary[k][f] = boundary_from_c(self.boundary[k][f])?;
+            }
+        }
+        d.mass = self.mass;
+        d.per_particle_mass = flag(self.per_particle_mass)?;
+        d.mass_classes = self.mass_classes;
+        d.obstacles = flag(self.obstacles)?;
+        d.surface_capacity = self.surface_capacity;
+        d.forces = Forces {
+            uniform: self.forces & mpca_force::Uniform as u32 != 0,
+            field: self.forces & mpca_force::Field as u32 != 0,
+            potential: self.forces & mpca_force::Potential as u32 != 0,
+            vortex: self.forces & mpca_force::Vortex as u32 != 0,
+        };
+        d.gravity = self.gravity;
+        d.vortex = Vortex { centre: self.vortex_centre, core_radius: self.vortex_core_radius, circulation: self.vortex_circulation };
+        d.restitution = self.restitution;
+        d.wall_restitution = self.wall_restitution;
+        d.dt = self.dt;
+        d.quantization = match self.quantization {
+            8 => Quantization::Bits8,
+            16 => Quantization::Bits16,
+            _ => return Err(mpca_status::BadEnum),
+        };
+        d.drift = match self.drift {
+            0 => Drift::Paper,
+            1 => Drift::Calibrated,
+            _ => return Err(mpca_status::BadEnum),
+        };
+        d.method = match self.method {
+            0 => Method::Exhaustive,
+            1 => Method::ExactFast,
+            2 => Method::Greedy,
+            _ => return Err(mpca_status::BadEnum),
+        };
+        d.emitter_capacity = self.emitter_capacity;
+        d.lifetimes = flag(self.lifetimes)?;
+        Ok(d)
+    }
+}
+
+/// Fills `out` with the defaults for a `dim`-dimensional world of
+/// `nx x ny (x nz)` cells: periodic faces, one mass of 1, no obstacles, no
+/// force, e = 1, dt = 1, seed 0, 8-bit velocities, the paper's drift rule,
+/// the exact-fast assignment, no emitters. Sets `struct_size`. Sizes are
+/// checked later, by mpca_world_bytes and mpca_world_init.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mpca_desc_defaults(out: *mut mpca_desc, dim: u32, nx: u32, ny: u32, nz: u32) -> mpca_status {
+    guard(|| {
+        let out = unsafe { write(out)? };
+        let d = if dim == 3 { Description::new_3d(nx, ny, nz) } else { Description::new_2d(nx, ny) };
+        let mut c = mpca_desc::from_core(&d);
+        c.dim = dim;
+        *out = c;
+        Ok(())
+    })
+}
+
+/// Checks a description in full without building anything.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mpca_desc_validate(desc: *const mpca_desc) -> mpca_status {
+    guard(|| Ok(unsafe { read(desc)? }.to_core()?.validate()?))
+}
+
+/// Bytes of memory a world built from `desc` needs with mpca_world_init,
+/// alignment slack included (any alignment of the memory is accepted).
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mpca_world_bytes(desc: *const mpca_desc, out_bytes: *mut usize) -> mpca_status {
+    guard(|| {
+        let d = unsafe { read(desc)? }.to_core()?;
+        let out = unsafe { write(out_bytes)? };
+        *out = mpca_core::world_bytes(&d)?;
+        Ok(())
+    })
+}

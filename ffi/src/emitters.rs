@@ -1,0 +1,61 @@
+//! Emitters (M6).
+
+use mpca_core::Emitter;
+
+use crate::world::world_mut;
+use crate::{check_size, guard, mpca_status, mpca_world, read, write};
+
+/// An emitter. Set `struct_size` to `sizeof(mpca_emitter)`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct mpca_emitter {
+    /// `sizeof(mpca_emitter)`.
+    pub struct_size: u32,
+    /// First cell of the region, inclusive.
+    pub min: [u32; 3],
+    /// Last cell of the region, exclusive (the third is ignored in 2D).
+    pub max: [u32; 3],
+    /// Mean particles per step, not negative.
+    pub rate: f32,
+    /// Initial velocity.
+    pub velocity: [f32; 3],
+    /// Radius of a uniform random spread added to the velocity;
+    /// |velocity| + spread <= 1.
+    pub spread: f32,
+    /// Mass of the emitted particles.
+    pub mass: f32,
+    /// Steps each particle lives, 0 for no limit, at most 65535; needs
+    /// `mpca_desc.lifetimes`.
+    pub lifetime: u32,
+}
+
+/// Adds an emitter; its index goes to `out_index`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mpca_world_add_emitter(world: *mut mpca_world, emitter: *const mpca_emitter, out_index: *mut u32) -> mpca_status {
+    guard(|| {
+        let w = unsafe { world_mut(world)? };
+        let e = unsafe { read(emitter)? };
+        let out = unsafe { write(out_index)? };
+        check_size::<mpca_emitter>(e.struct_size)?;
+        let index = w.add_emitter(Emitter {
+            min: e.min,
+            max: e.max,
+            rate: e.rate,
+            velocity: e.velocity,
+            spread: e.spread,
+            mass: e.mass,
+            lifetime: e.lifetime,
+        })?;
+        *out = index as u32;
+        Ok(())
+    })
+}
+
+/// Changes the rate of emitter `index`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mpca_world_set_emitter_rate(world: *mut mpca_world, index: u32, rate: f32) -> mpca_status {
+    guard(|| {
+        let w = unsafe { world_mut(world)? };
+        Ok(w.set_emitter_rate(index as usize, rate)?)
+    })
+}

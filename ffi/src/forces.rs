@@ -1,0 +1,65 @@
+//! Forces (M5.1): the uniform acceleration, the per-cell field, the
+//! potential and the Rankine vortex. Each needs its bit in
+//! `mpca_desc.forces`, else `MPCA_STATUS_NOT_ENABLED`.
+
+use mpca_core::Vortex;
+
+use crate::world::world_mut;
+use crate::{array, guard, mpca_status, mpca_world, slice};
+
+/// Sets the uniform acceleration (3 values).
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mpca_world_set_gravity(world: *mut mpca_world, g: *const f32) -> mpca_status {
+    guard(|| {
+        let w = unsafe { world_mut(world)? };
+        Ok(w.set_gravity(unsafe { array(g)? })?)
+    })
+}
+
+/// Replaces the force field: `dim` floats per cell, cells x fastest; `len`
+/// must be `dim` times the cell count.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mpca_world_set_force_field(world: *mut mpca_world, forces: *const f32, len: usize) -> mpca_status {
+    guard(|| {
+        let w = unsafe { world_mut(world)? };
+        Ok(w.set_force_field(unsafe { slice(forces, len)? })?)
+    })
+}
+
+/// Sets the force (3 values) on the cell at `pos`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mpca_world_set_cell_force(world: *mut mpca_world, pos: *const u32, force: *const f32) -> mpca_status {
+    guard(|| {
+        let w = unsafe { world_mut(world)? };
+        let (pos, f) = unsafe { (array(pos)?, array(force)?) };
+        Ok(w.set_cell_force(pos, f)?)
+    })
+}
+
+/// Replaces the potential: one float per cell, x fastest.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mpca_world_set_potential(world: *mut mpca_world, u: *const f32, len: usize) -> mpca_status {
+    guard(|| {
+        let w = unsafe { world_mut(world)? };
+        Ok(w.set_potential(unsafe { slice(u, len)? })?)
+    })
+}
+
+/// Sets the potential of the cell at `pos`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mpca_world_set_cell_potential(world: *mut mpca_world, pos: *const u32, u: f32) -> mpca_status {
+    guard(|| {
+        let w = unsafe { world_mut(world)? };
+        Ok(w.set_cell_potential(unsafe { array(pos)? }, u)?)
+    })
+}
+
+/// Sets the Rankine vortex: centre (`cx`, `cy`), core radius and
+/// circulation. Its axis is parallel to z in 3D.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mpca_world_set_vortex(world: *mut mpca_world, cx: f32, cy: f32, core_radius: f32, circulation: f32) -> mpca_status {
+    guard(|| {
+        let w = unsafe { world_mut(world)? };
+        Ok(w.set_vortex(Vortex { centre: [cx, cy], core_radius, circulation })?)
+    })
+}

@@ -1,0 +1,167 @@
+//! # libmpca: the C ABI of mpca
+//!
+//! Every export is `mpca_*`, returns an [`mpca_status`] (0 is success) and
+//! writes its results through out-parameters. The rules at this boundary:
+//!
+//! - **NULL** for any pointer argument returns `MPCA_STATUS_NULL_POINTER`;
+//!   nothing is dereferenced first.
+//! - **Handles** carry a tag tied to their address, cleared by
+//!   `mpca_world_destroy` / `mpca_world_deinit`; a destroyed, deinitialised
+//!   or forged handle returns `MPCA_STATUS_BAD_HANDLE`. Worlds from
+//!   `mpca_world_create` are also kept in a registry, so a destroyed one is
+//!   refused without its freed memory being read.
+//! - **Bad values** (NaN, infinities, out-of-range numbers, unknown enum
+//!   values, wrong `struct_size`) return a status and leave the world
+//!   unchanged.
+//! - **Panics** never unwind into C. With the default `std` feature every
+//!   export runs inside `catch_unwind` and returns `MPCA_STATUS_PANIC`;
+//!   without it (firmware builds, which abort on panic by target default) a
+//!   panic halts in a spin loop. No input is meant to panic: a panic is a bug.
+//! - **Threads**: a world may move between threads but must not be used
+//!   from two at once.
+#![no_std]
+#![deny(missing_docs)]
+#![allow(non_camel_case_types)]
+#![allow(clippy::missing_safety_doc)] // the C header is the contract; see each function's docs
+
+#[cfg(feature = "std")]
+extern crate std;
+
+mod desc;
+mod emitters;
+mod forces;
+mod obstacles;
+mod particles;
+mod status;
+mod world;
+
+pub use desc::*;
+pub use emitters::*;
+pub use forces::*;
+pub use obstacles::*;
+pub use particles::*;
+pub use status::*;
+pub use world::*;
+
+/// Major version of this library.
+pub const MPCA_VERSION_MAJOR: u32 = 0;
+/// Minor version of this library.
+pub const MPCA_VERSION_MINOR: u32 = 1;
+/// Patch version of this library.
+pub const MPCA_VERSION_PATCH: u32 = 0;
+
+/// The library's version, "MAJOR.MINOR.PATCH", as a static string.
+#[unsafe(no_mangle)]
+pub extern "C" fn mpca_version() -> *const core::ffi::c_char {
+    const V: &core::ffi::CStr = match core::ffi::CStr::from_bytes_with_nul(concat!(env!("CARGO_PKG_VERSION"), "\0").as_bytes()) {
+        Ok(v) => v,
+        Err(_) => c"?",
+    };
+    V.as_ptr()
+}
+
+// The layout C sees, fixed: the C tests assert the same with _Static_assert.
+const _: () = {
+    use core::mem::{align_of, size_of};
+    assert!(size_of::<mpca_desc>() == 136 && align_of::<mpca_desc>() == 8);
+    assert!(size_of::<mpca_stats>() == 144 && align_of::<mpca_stats>() == 8);
+    assert!(size_of::<mpca_particle>() == 32 && align_of::<mpca_particle>() == 4);
+    assert!(size_of::<mpca_cell>() == 36 && align_of::<mpca_cell>() == 4);
+    assert!(size_of::<mpca_emitter>() == 56 && align_of::<mpca_emitter>() == 4);
+    assert!(size_of::<mpca_status>() == 4 && size_of::<mpca_boundary>() == 4);
+};
+
+/// Runs an export's body inside the panic boundary and turns its result into
+/// a status.
+#[inline]
+pub(crate) fn guard(body: impl FnOnce() -> Result<(), mpca_status>) -> mpca_status {
+    #[cfg(feature = "std")]
+    let result = match std::panic::catch_unwind(core::panic::AssertUnwindSafe(body)) {
+        Ok(r) => r,
+        Err(_) => Err(mpca_status::Panic),
+    };
+    #[cfg(not(feature = "std"))]
+    let result = body();
+    match result {
+        Ok(()) => mpca_status::Ok,
+        Err(s) => s,
+    }
+}
+
+/// `&*p`, or `NullPointer`.
+#[inline]
+pub(crate) unsafe fn read<'a, T>(p: *const T) -> Result<&'a T, mpca_status> {
+    // SAFETY: the caller's pointer is valid if not NULL (the C contract).
+    unsafe { p.as_ref() }.ok_or(mpca_status::NullPointer)
+}
+
+/// `&mut *p`, or `NullPointer`.
+#[inline]
+pub(crate) unsafe fn write<'a, T>(p: *mut T) -> Result<&'a mut T, mpca_status> {
+    // SAFETY: as in `read`.
+    unsafe { p.as_mut() }.ok_or(mpca_status::NullPointer)
+}
+
+/// `n` values at `p` (3 for positions and vectors), or `NullPointer`.
+#[inline]
+pub(crate) unsafe fn array<T: Copy, const N: usize>(p: *const T) -> Result<[T; N], mpca_status> {
+    if p.is_null() {
+        return Err(mpca_status::NullPointer);
+    }
+    // SAFETY: the C contract: `p` points at N readable values.
+    Ok(core::array::from_fn(|i| unsafe { p.add(i).read() }))
+}
+
+/// A slice of `len` values at `p`; NULL is refused even when `len` is 0.
+#[inline]
+pub(crate) unsafe fn slice<'a, T>(p: *const T, len: usize) -> Result<&'a [T], mpca_status> {
+    if p.is_null() {
+        return Err(mpca_status::NullPointer);
+    }
+    // SAFETY: the C contract: `p` points at `len` readable values.
+    Ok(unsafe { core::slice::from_raw_parts(p, len) })
+}
+
+/// A mutable slice of `len` values at `p`; NULL is refused.
+#[inline]
+pub(crate) unsafe fn slice_mut<'a, T>(p: *mut T, len: usize) -> Result<&'a mut [T], mpca_status> {
+    if p.is_null() {
+        return Err(mpca_status::NullPointer);
+    }
+    // SAFETY: the C contract: `p` points at `len` writable values.
+    Ok(unsafe { core::slice::from_raw_parts_mut(p, len) })
+}
+
+/// 0 or 1 as a bool; anything else is `BadEnum`.
+#[inline]
+pub(crate) fn flag(v: u32) -> Result<bool, mpca_status> {
+    match v {
+        0 => Ok(false),
+        1 => Ok(true),
+        _ => Err(mpca_status::BadEnum),
+    }
+}
+
+/// Checks the leading `struct_size` of a versioned structure.
+#[inline]
+pub(crate) fn check_size<T>(struct_size: u32) -> Result<(), mpca_status> {
+    if struct_size as usize == core::mem::size_of::<T>() { Ok(()) } else { Err(mpca_status::BadStructSize) }
+}
+
+#[cfg(not(feature = "std"))]
+#[panic_handler]
+fn on_panic(_: &core::panic::PanicInfo<'_>) -> ! {
+    // Firmware builds: no unwinding exists to cross into C; halt here.
+    loop {
+        core::hint::spin_loop();
+    }
+}
+
+/// Panics on purpose, inside the panic boundary, so tests can show that a
+/// panic returns `MPCA_STATUS_PANIC` instead of unwinding into C. Only in
+/// builds with the `panic-test` feature.
+#[cfg(feature = "panic-test")]
+#[unsafe(no_mangle)]
+pub extern "C" fn mpca_debug_panic() -> mpca_status {
+    guard(|| panic!("mpca_debug_panic was called"))
+}

@@ -1,0 +1,204 @@
+//! Particles: adding, removing, reading cells, and export into caller arrays
+//! for vertex buffers and textures.
+
+use mpca_core::{Cell, Particle};
+
+use crate::world::{world_mut, world_ref};
+use crate::{array, guard, mpca_status, mpca_world, slice_mut, write};
+
+/// One particle.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct mpca_particle {
+    /// Cell coordinates; the third is 0 in 2D.
+    pub pos: [u32; 3],
+    /// Velocity in cells per step; the third is 0 in 2D.
+    pub velocity: [f32; 3],
+    /// Mass.
+    pub mass: f32,
+    /// Steps left to live, 0 for no limit.
+    pub life: u32,
+}
+
+/// What a cell holds. Values of `mpca_cell.kind`.
+#[repr(u32)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum mpca_cell_kind {
+    /// Nothing.
+    Empty = 0,
+    /// A particle, described in `mpca_cell.particle`.
+    Particle = 1,
+    /// An obstacle.
+    Obstacle = 2,
+}
+
+/// One cell.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct mpca_cell {
+    /// An `mpca_cell_kind` value.
+    pub kind: u32,
+    /// The particle, when `kind` is MPCA_CELL_KIND_PARTICLE; zero otherwise.
+    pub particle: mpca_particle,
+}
+
+fn particle_to_c(p: Particle) -> mpca_particle {
+    mpca_particle { pos: p.pos, velocity: p.velocity, mass: p.mass, life: u32::from(p.life) }
+}
+
+/// Adds a particle of the world's mass at `pos` (3 values) with velocity
+/// `velocity` (3 values; |v| <= 1; the third is ignored in 2D).
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mpca_world_add_particle(world: *mut mpca_world, pos: *const u32, velocity: *const f32) -> mpca_status {
+    guard(|| {
+        let w = unsafe { world_mut(world)? };
+        let (pos, v) = unsafe { (array(pos)?, array(velocity)?) };
+        Ok(w.add_particle(pos, v)?)
+    })
+}
+
+/// Adds a particle of mass `mass`; worlds without per-particle masses accept
+/// only their own mass.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mpca_world_add_particle_mass(
+    world: *mut mpca_world,
+    pos: *const u32,
+    velocity: *const f32,
+    mass: f32,
+) -> mpca_status {
+    guard(|| {
+        let w = unsafe { world_mut(world)? };
+        let (pos, v) = unsafe { (array(pos)?, array(velocity)?) };
+        Ok(w.add_particle_with_mass(pos, v, mass)?)
+    })
+}
+
+/// Removes the particle at `pos`, writing it to `out` (which may not be
+/// NULL).
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mpca_world_remove_particle(world: *mut mpca_world, pos: *const u32, out: *mut mpca_particle) -> mpca_status {
+    guard(|| {
+        let w = unsafe { world_mut(world)? };
+        let pos = unsafe { array(pos)? };
+        let out = unsafe { write(out)? };
+        *out = particle_to_c(w.remove_particle(pos)?);
+        Ok(())
+    })
+}
+
+/// What the cell at `pos` holds.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mpca_world_cell(world: *const mpca_world, pos: *const u32, out: *mut mpca_cell) -> mpca_status {
+    guard(|| {
+        let w = unsafe { world_ref(world)? };
+        let pos = unsafe { array(pos)? };
+        let out = unsafe { write(out)? };
+        *out = match w.cell(pos)? {
+            Cell::Empty => mpca_cell { kind: mpca_cell_kind::Empty as u32, ..Default::default() },
+            Cell::Obstacle => mpca_cell { kind: mpca_cell_kind::Obstacle as u32, ..Default::default() },
+            Cell::Particle(p) => mpca_cell { kind: mpca_cell_kind::Particle as u32, particle: particle_to_c(p) },
+        };
+        Ok(())
+    })
+}
+
+/// The number of particles now.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mpca_world_particle_count(world: *const mpca_world, out_count: *mut usize) -> mpca_status {
+    guard(|| {
+        let w = unsafe { world_ref(world)? };
+        *unsafe { write(out_count)? } = w.particle_count() as usize;
+        Ok(())
+    })
+}
+
+/// Writes `per` floats of each particle, in cell order, into `out`, which
+/// has room for `capacity` particles; the particle count goes to
+/// `out_count`. Too small a buffer writes nothing but the count.
+unsafe fn export(
+    world: *const mpca_world,
+    out: *mut f32,
+    capacity: usize,
+    out_count: *mut usize,
+    per: usize,
+    put: impl Fn(&Particle, &mut [f32]),
+) -> mpca_status {
+    guard(|| {
+        let w = unsafe { world_ref(world)? };
+        let count = unsafe { write(out_count)? };
+        if out.is_null() {
+            return Err(mpca_status::NullPointer);
+        }
+        let n = w.particle_count() as usize;
+        *count = n;
+        if capacity < n {
+            return Err(mpca_status::OutputTooSmall);
+        }
+        let dst = unsafe { slice_mut(out, n * per)? };
+        for (p, chunk) in w.particles().zip(dst.chunks_exact_mut(per)) {
+            put(&p, chunk);
+        }
+        Ok(())
+    })
+}
+
+/// Particle positions as 3 floats each (cell centres: x + 0.5, y + 0.5,
+/// z + 0.5; z is 0.5 in 2D), ready for a vertex buffer. `capacity` counts
+/// particles (the buffer holds 3 * capacity floats).
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mpca_world_export_positions(
+    world: *const mpca_world,
+    out: *mut f32,
+    capacity: usize,
+    out_count: *mut usize,
+) -> mpca_status {
+    unsafe { export(world, out, capacity, out_count, 3, |p, o| o.copy_from_slice(&p.pos.map(|c| c as f32 + 0.5))) }
+}
+
+/// Particle velocities as 3 floats each, in the order of
+/// mpca_world_export_positions.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mpca_world_export_velocities(
+    world: *const mpca_world,
+    out: *mut f32,
+    capacity: usize,
+    out_count: *mut usize,
+) -> mpca_status {
+    unsafe { export(world, out, capacity, out_count, 3, |p, o| o.copy_from_slice(&p.velocity)) }
+}
+
+/// Particle masses, one float each, in the order of
+/// mpca_world_export_positions.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mpca_world_export_masses(
+    world: *const mpca_world,
+    out: *mut f32,
+    capacity: usize,
+    out_count: *mut usize,
+) -> mpca_status {
+    unsafe { export(world, out, capacity, out_count, 1, |p, o| o[0] = p.mass) }
+}
+
+/// The share of occupied cells in each of `res` (3 values; the third 1 in
+/// 2D) bins per axis, x fastest, into `out` of `len` floats (the product of
+/// `res`). With `res` equal to the world size this is the occupancy.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mpca_world_density(world: *const mpca_world, res: *const u32, out: *mut f32, len: usize) -> mpca_status {
+    guard(|| {
+        let w = unsafe { world_ref(world)? };
+        let res = unsafe { array(res)? };
+        let out = unsafe { slice_mut(out, len)? };
+        Ok(w.density(res, out)?)
+    })
+}
+
+/// As mpca_world_density, scaled to 0..255 bytes for a texture upload.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mpca_world_density_u8(world: *const mpca_world, res: *const u32, out: *mut u8, len: usize) -> mpca_status {
+    guard(|| {
+        let w = unsafe { world_ref(world)? };
+        let res = unsafe { array(res)? };
+        let out = unsafe { slice_mut(out, len)? };
+        Ok(w.density_u8(res, out)?)
+    })
+}
