@@ -48,14 +48,14 @@ unsafe impl Plain for Slot {}
 impl World {
     /// Adds an emitter and returns its index.
     pub fn add_emitter(&mut self, e: Emitter) -> Result<usize, Error> {
+        // Every float is checked as given, before 2D drops the third axis.
+        finite(&[e.rate, e.velocity[0], e.velocity[1], e.velocity[2], e.spread])?;
         let mut e = e;
-        let dim = self.dim();
-        if dim == 2 {
+        if self.dim() == 2 {
             e.min[2] = 0;
             e.max[2] = 1;
             e.velocity[2] = 0.0;
         }
-        finite(&[e.rate, e.velocity[0], e.velocity[1], e.velocity[2], e.spread])?;
         let n = self.layout().n;
         if e.rate < 0.0 || e.spread < 0.0 || (0..3).any(|k| e.min[k] >= e.max[k] || e.max[k] as usize > n[k]) {
             return Err(Error::BadEmitter);

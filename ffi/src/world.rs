@@ -37,6 +37,14 @@ mod registry {
         });
     }
 
+    /// A world built by mpca_world_init at `p`, perhaps where a destroyed
+    /// one was: the address is live memory again.
+    pub fn reused(p: usize) {
+        with(|s| {
+            s.dead.remove(&p);
+        });
+    }
+
     pub fn died(p: usize) {
         with(|s| {
             s.live.remove(&p);
@@ -85,7 +93,10 @@ pub unsafe extern "C" fn mpca_world_init(
         let out = unsafe { write(out_world)? };
         let bytes = unsafe { crate::slice_mut(memory.cast::<u8>(), len)? };
         let world = World::init(&d, bytes)?;
-        *out = world.as_ptr().cast::<mpca_world>();
+        let p = world.as_ptr();
+        #[cfg(feature = "std")]
+        registry::reused(p as usize);
+        *out = p.cast::<mpca_world>();
         Ok(())
     })
 }

@@ -1,0 +1,708 @@
+//! The C ABI, used from C: programs in `tests/c/` compiled with the cc crate
+//! against the real `libmpca.a` and `libmpca.so`, run, and their output
+//! checked here.
+//!
+//! - `errors.c` (linked statically): structure layouts, every error path,
+//!   every status message, the panic boundary; prints `error cases: N`.
+//! - `scenes.c` (linked dynamically): a 2D and a 3D scene stepped from C,
+//!   whose hashes and statistics must equal those of the same scenes built
+//!   here through the Rust API; the exports against the cells.
+//! - `reuse.c`: caller memory at the address of a destroyed world.
+//! - `header_only.c`: `include/mpca.h` alone, as C99 and as C++11.
+//!
+//! With `MPCA_C_SANITIZE=1` every program is built with AddressSanitizer
+//! (LeakSanitizer included) and UndefinedBehaviorSanitizer, into a separate
+//! directory, and the tests check that the sanitizer is really linked in.
+//! ELF inspection and the link flags assume Linux.
+#![cfg(target_os = "linux")]
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::sync::OnceLock;
+
+use mpca::{Boundary, Description, Drift, Emitter, Method, Quantization, Shape, Stats, World, WorldBox};
+
+/// Error cases `errors.c` must try. It tries 1,795 today; the margin is
+/// for cases merged or reworded, not for groups dropped.
+const MIN_ERROR_CASES: u64 = 1700;
+
+const SANITIZE_FLAGS: [&str; 3] = ["-fsanitize=address,undefined", "-fno-omit-frame-pointer", "-fno-sanitize-recover=all"];
+
+fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR")).parent().expect("tests/ lies in the workspace")
+}
+
+fn sanitize() -> bool {
+    std::env::var("MPCA_C_SANITIZE").is_ok_and(|v| v == "1")
+}
+
+/// The directory holding `libmpca.a` and `libmpca.so`, built once per test
+/// process with the `panic-test` feature (for `mpca_debug_panic`).
+///
+/// A nested cargo, because the C programs need the real libraries: mpca-ffi
+/// is a staticlib and a cdylib with no rlib, so this crate cannot depend on
+/// it and the outer build never produces them for the tests. Its own target
+/// directory keeps it off the build directory lock that the outer `cargo
+/// test` holds while the tests run.
+fn library() -> &'static Path {
+    static DIR: OnceLock<PathBuf> = OnceLock::new();
+    DIR.get_or_init(|| {
+        let target_dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("ffi");
+        let cargo = std::env::var_os("CARGO").unwrap_or_else(|| env!("CARGO").into());
+        let out = Command::new(cargo)
+            .current_dir(root())
+            .args(["build", "--release", "-p", "mpca-ffi", "--features", "panic-test", "--target-dir"])
+            .arg(&target_dir)
+            .output()
+            .expect("cargo runs");
+        assert!(out.status.success(), "building libmpca failed:\n{}", String::from_utf8_lossy(&out.stderr));
+        let dir = target_dir.join("release");
+        for lib in ["libmpca.a", "libmpca.so"] {
+            assert!(dir.join(lib).is_file(), "{lib} missing from {}", dir.display());
+        }
+        dir
+    })
+}
+
+/// Where the C programs go; sanitized builds apart from plain ones.
+fn out_dir() -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("c_abi").join(if sanitize() { "sanitize" } else { "plain" });
+    std::fs::create_dir_all(&dir).expect("create the C output directory");
+    dir
+}
+
+/// The C (or C++) compiler as cc configures it for this target, with the
+/// project's warning flags, the include paths and, when asked, sanitizers.
+fn compiler(cpp: bool, panic_test: bool) -> Command {
+    let mut build = cc::Build::new();
+    build
+        .cargo_metadata(false)
+        .cargo_warnings(false)
+        .target(env!("MPCA_TEST_TARGET"))
+        .host(env!("MPCA_TEST_HOST"))
+        .opt_level(if sanitize() { 1 } else { 2 })
+        .debug(true)
+        .cpp(cpp)
+        .std(if cpp { "c++11" } else { "c99" })
+        // -Wall -Wextra -Wpedantic -Werror
+        .warnings(true)
+        .extra_warnings(true)
+        .flag("-Wpedantic")
+        .warnings_into_errors(true)
+        .include(root().join("include"))
+        .include(root().join("tests/c"));
+    if panic_test {
+        // The library is built with panic-test, so the header declares
+        // mpca_debug_panic for these programs.
+        build.define("MPCA_PANIC_TEST", None);
+    }
+    let tool = build.get_compiler();
+    let mut cmd = tool.to_command();
+    if sanitize() {
+        cmd.args(SANITIZE_FLAGS);
+        if tool.is_like_clang() {
+            // GCC links libasan dynamically; make Clang do the same, so the
+            // dependency shows in the executable.
+            cmd.arg("-shared-libasan");
+        }
+    }
+    cmd
+}
+
+#[derive(Clone, Copy, Debug)]
+enum Link {
+    Static,
+    Shared,
+}
+
+/// The command line, without the environment `Debug` would list.
+fn command_line(cmd: &Command) -> String {
+    std::iter::once(cmd.get_program()).chain(cmd.get_args()).map(|a| a.to_string_lossy()).collect::<Vec<_>>().join(" ")
+}
+
+/// Compiles and links `tests/c/<sources>` into `<name>`.
+fn build(name: &str, sources: &[&str], link: Link) -> PathBuf {
+    let lib = library();
+    let exe = out_dir().join(name);
+    let mut cmd = compiler(false, true);
+    cmd.arg("-o").arg(&exe);
+    for s in sources {
+        cmd.arg(root().join("tests/c").join(s));
+    }
+    match link {
+        // By path, so the linker cannot pick libmpca.so instead.
+        Link::Static => cmd.arg(lib.join("libmpca.a")).args(["-lm", "-lpthread", "-ldl"]),
+        Link::Shared => cmd
+            .arg(format!("-L{}", lib.display()))
+            .args(["-lmpca", "-lm"])
+            .arg(format!("-Wl,-rpath,{}", lib.display())),
+    };
+    let out = cmd.output().expect("the C compiler runs");
+    assert!(
+        out.status.success(),
+        "compiling {name} ({link:?}) failed:\n{}\n{}{}",
+        command_line(&cmd),
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    exe
+}
+
+/// One run of a C program.
+struct Run {
+    exe: PathBuf,
+    ok: bool,
+    status: String,
+    stdout: String,
+    stderr: String,
+}
+
+impl Run {
+    /// The lines that start with `prefix`, without it.
+    fn values(&self, prefix: &str) -> Vec<&str> {
+        self.stdout.lines().filter_map(|l| l.strip_prefix(prefix)).collect()
+    }
+
+    /// The first line that starts with `prefix`, without it.
+    fn value(&self, prefix: &str) -> &str {
+        match self.values(prefix).first() {
+            Some(v) => v,
+            None => panic!(
+                "{} printed no `{prefix}` line (exit: {}):\n{}\n--- stderr (tail) ---\n{}",
+                self.name(),
+                self.status,
+                self.stdout,
+                tail(&self.stderr, 30)
+            ),
+        }
+    }
+
+    fn name(&self) -> String {
+        self.exe.file_name().unwrap().to_string_lossy().into_owned()
+    }
+
+    /// The program ran to its end (it prints `checks:` last) and no check
+    /// of the case group `context` failed; for tests that look at one part
+    /// of a program's output, so that a failure elsewhere is reported by
+    /// the test of that part.
+    fn assert_no_failures_in(&self, context: &str) {
+        self.value("checks: ");
+        let marker = format!("[{context}");
+        let failed: Vec<&str> = self.stdout.lines().filter(|l| l.starts_with("FAILED") && l.contains(&marker)).collect();
+        assert!(failed.is_empty(), "{}: failed checks of {context}:\n{}", self.name(), failed.join("\n"));
+    }
+
+    /// Exit status 0, with the program's failed checks and sanitizer
+    /// reports in the message otherwise.
+    fn assert_success(&self) {
+        let failed: Vec<&str> = self.stdout.lines().filter(|l| l.starts_with("FAILED") || l.starts_with("checks:")).collect();
+        assert!(
+            self.ok,
+            "{} exited with {}\n{}\n--- stderr (tail) ---\n{}",
+            self.name(),
+            self.status,
+            failed.join("\n"),
+            tail(&self.stderr, 60)
+        );
+    }
+}
+
+fn tail(text: &str, lines: usize) -> String {
+    let all: Vec<&str> = text.lines().collect();
+    all[all.len().saturating_sub(lines)..].join("\n")
+}
+
+fn run(exe: PathBuf, asan_options: &str) -> Run {
+    let out = Command::new(&exe)
+        // cargo points LD_LIBRARY_PATH at its own target directories, which
+        // may hold another libmpca.so (without panic-test), and the loader
+        // searches it before the RUNPATH the shared build carries.
+        .env_remove("LD_LIBRARY_PATH")
+        // LeakSanitizer is on by default on Linux; say so anyway.
+        .env("ASAN_OPTIONS", format!("detect_leaks=1:halt_on_error=1{asan_options}"))
+        .env("UBSAN_OPTIONS", "print_stacktrace=1:halt_on_error=1")
+        .env("RUST_BACKTRACE", "0")
+        .output()
+        .expect("the C program runs");
+    let run = Run {
+        exe,
+        ok: out.status.success(),
+        status: out.status.to_string(),
+        stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
+        stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
+    };
+    // Printed so that `--nocapture` logs (and .ci/run) show it.
+    println!("{}: sanitizer: {}", run.name(), run.value("sanitizer: "));
+    run
+}
+
+/// The runs of `errors.c` (static), `scenes.c` (shared) and `reuse.c`
+/// (shared), each built and run once per test process.
+fn errors() -> &'static Run {
+    static RUN: OnceLock<Run> = OnceLock::new();
+    RUN.get_or_init(|| run(build("errors", &["errors.c", "check.c"], Link::Static), ""))
+}
+
+fn scenes() -> &'static Run {
+    static RUN: OnceLock<Run> = OnceLock::new();
+    RUN.get_or_init(|| run(build("scenes", &["scenes.c", "check.c"], Link::Shared), ""))
+}
+
+fn reuse() -> &'static Run {
+    static RUN: OnceLock<Run> = OnceLock::new();
+    // Without its quarantine ASan hands freed blocks back, as glibc does.
+    RUN.get_or_init(|| {
+        run(build("reuse", &["reuse.c", "check.c"], Link::Shared), ":quarantine_size_mb=0:thread_local_quarantine_size_kb=0")
+    })
+}
+
+/// `include/mpca.h` without its comments.
+fn header_code() -> String {
+    let text = std::fs::read_to_string(root().join("include/mpca.h")).expect("include/mpca.h");
+    let mut code = String::with_capacity(text.len());
+    let mut rest = text.as_str();
+    while !rest.is_empty() {
+        if let Some(after) = rest.strip_prefix("/*") {
+            rest = after.split_once("*/").map_or("", |(_, r)| r);
+            code.push(' ');
+        } else if rest.starts_with("//") {
+            rest = rest.find('\n').map_or("", |i| &rest[i..]);
+        } else {
+            let c = rest.chars().next().unwrap();
+            code.push(c);
+            rest = &rest[c.len_utf8()..];
+        }
+    }
+    code
+}
+
+/// Every function the header declares: `mpca_[a-z0-9_]+` followed by `(`,
+/// outside comments (those under `#if defined(MPCA_PANIC_TEST)` included).
+fn header_functions() -> BTreeSet<String> {
+    let code = header_code();
+    let ident = |c: char| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_';
+    let mut names = BTreeSet::new();
+    for (i, _) in code.match_indices("mpca_") {
+        if code[..i].chars().next_back().is_some_and(|c| c.is_ascii_alphanumeric() || c == '_') {
+            continue;
+        }
+        let len = code[i..].find(|c: char| !ident(c)).unwrap_or(code.len() - i);
+        if code[i + len..].starts_with('(') {
+            names.insert(code[i..i + len].to_string());
+        }
+    }
+    assert!(names.len() > 30, "the header parse found only {names:?}");
+    names
+}
+
+/// Every `MPCA_STATUS_NAME = number` of the header.
+fn header_statuses() -> BTreeMap<String, u32> {
+    header_code()
+        .lines()
+        .filter_map(|l| {
+            let (name, value) = l.trim().trim_end_matches(',').split_once(" = ")?;
+            name.starts_with("MPCA_STATUS_").then(|| Some((name.to_string(), value.parse().ok()?)))?
+        })
+        .collect()
+}
+
+/// What the dynamic section and symbol table of an ELF64 little-endian file
+/// say: the libraries it needs, and the functions it exports.
+struct Elf {
+    data: Vec<u8>,
+}
+
+/// One section header: type, file offset, size, linked section.
+struct Section {
+    kind: u32,
+    offset: usize,
+    size: usize,
+    link: usize,
+}
+
+impl Elf {
+    const SHT_DYNSYM: u32 = 11;
+    const SHT_DYNAMIC: u32 = 6;
+    const DT_NEEDED: u64 = 1;
+
+    fn read(path: &Path) -> Elf {
+        let data = std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        assert!(data.starts_with(b"\x7fELF\x02\x01"), "{} is not ELF64 little-endian", path.display());
+        Elf { data }
+    }
+
+    fn uint(&self, at: usize, bytes: usize) -> u64 {
+        self.data[at..at + bytes].iter().rev().fold(0, |v, &b| (v << 8) | u64::from(b))
+    }
+
+    fn sections(&self) -> Vec<Section> {
+        let (offset, size, count) = (self.uint(0x28, 8) as usize, self.uint(0x3a, 2) as usize, self.uint(0x3c, 2) as usize);
+        (0..count)
+            .map(|i| {
+                let h = offset + i * size;
+                Section {
+                    kind: self.uint(h + 4, 4) as u32,
+                    offset: self.uint(h + 24, 8) as usize,
+                    size: self.uint(h + 32, 8) as usize,
+                    link: self.uint(h + 40, 4) as usize,
+                }
+            })
+            .collect()
+    }
+
+    fn string(&self, table: &Section, at: usize) -> String {
+        let bytes = &self.data[table.offset + at..table.offset + table.size];
+        String::from_utf8_lossy(&bytes[..bytes.iter().position(|&b| b == 0).unwrap_or(bytes.len())]).into_owned()
+    }
+
+    /// The DT_NEEDED entries of the dynamic section.
+    fn needed(&self) -> Vec<String> {
+        let sections = self.sections();
+        let mut names = Vec::new();
+        for s in sections.iter().filter(|s| s.kind == Self::SHT_DYNAMIC) {
+            for e in (s.offset..s.offset + s.size).step_by(16) {
+                if self.uint(e, 8) == Self::DT_NEEDED {
+                    names.push(self.string(&sections[s.link], self.uint(e + 8, 8) as usize));
+                }
+            }
+        }
+        names
+    }
+
+    /// Defined global functions of the dynamic symbol table.
+    fn exported_functions(&self) -> BTreeSet<String> {
+        let sections = self.sections();
+        let mut names = BTreeSet::new();
+        for s in sections.iter().filter(|s| s.kind == Self::SHT_DYNSYM) {
+            for e in (s.offset..s.offset + s.size).step_by(24) {
+                let info = self.uint(e + 4, 1);
+                let (binding, kind, defined) = (info >> 4, info & 0xf, self.uint(e + 6, 2) != 0);
+                if defined && kind == 2 && (binding == 1 || binding == 2) {
+                    names.insert(self.string(&sections[s.link], self.uint(e, 4) as usize));
+                }
+            }
+        }
+        names
+    }
+}
+
+// --- The header ------------------------------------------------------------
+
+#[test]
+fn header_compiles_alone_as_c99_and_as_cpp11() {
+    let source = root().join("tests/c/header_only.c");
+    for cpp in [false, true] {
+        for panic_test in [false, true] {
+            let mut cmd = compiler(cpp, panic_test);
+            if cpp {
+                cmd.args(["-x", "c++"]);
+            }
+            let out = cmd.arg("-fsyntax-only").arg(&source).output().expect("the compiler runs");
+            assert!(
+                out.status.success(),
+                "mpca.h alone does not compile ({}, MPCA_PANIC_TEST {panic_test}):\n{}\n{}",
+                if cpp { "C++11" } else { "C99" },
+                command_line(&cmd),
+                String::from_utf8_lossy(&out.stderr)
+            );
+        }
+    }
+}
+
+// --- Linking -----------------------------------------------------------------
+
+#[test]
+fn static_and_shared_programs_link_the_library_they_should() {
+    let is_mpca = |n: &String| n.starts_with("libmpca.so");
+    let needed = Elf::read(&errors().exe).needed();
+    assert!(!needed.iter().any(is_mpca), "errors (linked with libmpca.a) needs {needed:?}");
+    assert!(needed.iter().any(|n| n.starts_with("libc.so")), "the ELF parse found no libc in {needed:?}");
+    let needed = Elf::read(&scenes().exe).needed();
+    assert!(needed.iter().any(is_mpca), "scenes (linked with -lmpca) needs only {needed:?}");
+}
+
+#[test]
+fn shared_library_exports_exactly_the_header_functions() {
+    let exported: BTreeSet<String> = Elf::read(&library().join("libmpca.so"))
+        .exported_functions()
+        .into_iter()
+        .filter(|n| n.starts_with("mpca_"))
+        .collect();
+    assert_eq!(exported, header_functions(), "libmpca.so's mpca_* functions against include/mpca.h");
+}
+
+#[test]
+fn every_header_function_is_in_the_c_symbol_table_and_called_from_c() {
+    let header = header_functions();
+    let mut called = BTreeSet::new();
+    for run in [errors(), scenes()] {
+        // The table of check.c, linked into both programs: static and shared
+        // linking each resolve every function of the header.
+        let table: BTreeSet<String> = run.values("symbol: ").into_iter().map(String::from).collect();
+        assert_eq!(table, header, "{}: the symbol table of tests/c/check.c against the header", run.name());
+        called.extend(run.values("called: ").into_iter().map(String::from));
+    }
+    let never: Vec<_> = header.difference(&called).collect();
+    assert!(never.is_empty(), "functions no C program calls: {never:?}");
+}
+
+// --- Error paths, messages, panics -----------------------------------------
+
+#[test]
+fn every_error_path_is_refused_from_c_and_changes_nothing() {
+    let run = errors();
+    let cases: u64 = run.value("error cases: ").parse().expect("a count");
+    println!("errors: {cases} error cases tried from C");
+    run.assert_success();
+    assert!(cases >= MIN_ERROR_CASES, "only {cases} error cases, at least {MIN_ERROR_CASES} expected");
+}
+
+#[test]
+fn every_status_of_the_header_has_a_message() {
+    let run = errors();
+    let printed: BTreeMap<String, u32> = run
+        .values("status: ")
+        .into_iter()
+        .map(|l| {
+            let (name, value) = l.split_once(' ').expect("status: NAME N");
+            (name.to_string(), value.parse().expect("a number"))
+        })
+        .collect();
+    // errors.c checked each message (non-empty, distinct) and the one for
+    // numbers that are no status; here its table is held to the header.
+    assert_eq!(printed, header_statuses(), "the status table of tests/c/errors.c against the header");
+    assert!(!run.value("unknown status message: ").is_empty());
+    run.assert_no_failures_in("status messages");
+}
+
+#[test]
+fn a_panic_inside_the_library_comes_back_to_c_as_a_status() {
+    let run = errors();
+    assert_eq!(run.value("panic: "), "mpca_debug_panic returned 3 and the program goes on");
+    run.value("after panic: ");
+    run.assert_no_failures_in("panic boundary");
+}
+
+// --- Scenes --------------------------------------------------------------------
+
+// The 2D scene of tests/c/scenes.c: the same constants, the same calls in
+// the same order.
+const S2_SIZE: u32 = 32;
+const S2_SEED: u64 = 2024;
+const S2_GRAVITY_Y: f32 = -0.02;
+const S2_RESTITUTION: f32 = 0.9;
+const S2_WALL_RESTITUTION: f32 = 0.7;
+const S2_DISC_X: f32 = 16.0;
+const S2_DISC_Y: f32 = 12.0;
+const S2_DISC_RADIUS: f32 = 5.0;
+const S2_DISC_E: f32 = 0.8;
+const S2_EMIT_MIN_X: u32 = 4;
+const S2_EMIT_MIN_Y: u32 = 26;
+const S2_EMIT_MAX_X: u32 = 28;
+const S2_EMIT_MAX_Y: u32 = 30;
+const S2_EMIT_RATE: f32 = 1.5;
+const S2_EMIT_VX: f32 = 0.1;
+const S2_EMIT_VY: f32 = -0.3;
+const S2_EMIT_SPREAD: f32 = 0.2;
+const S2_EMIT_LIFETIME: u32 = 20;
+const S2_PARTICLES: u32 = 10;
+const S2_PARTICLE_Y: u32 = 20;
+const S2_SPEED_X: f32 = 0.6;
+const S2_MISALIGN: usize = 3;
+const S2_STEPS: u64 = 50;
+
+fn scene_2d() -> (u64, Stats) {
+    let mut d = Description::new_2d(S2_SIZE, S2_SIZE);
+    d.seed = S2_SEED;
+    d.boundary[0] = [Boundary::Open; 2];
+    d.boundary[1] = [Boundary::Wall; 2];
+    d.forces.uniform = true;
+    d.gravity[1] = S2_GRAVITY_Y;
+    d.restitution = S2_RESTITUTION;
+    d.wall_restitution = S2_WALL_RESTITUTION;
+    d.obstacles = true;
+    d.surface_capacity = 256;
+    d.lifetimes = true;
+    d.emitter_capacity = 1;
+    d.validate().unwrap();
+
+    let bytes = mpca::world_bytes(&d).unwrap();
+    let mut memory = vec![0u8; bytes + S2_MISALIGN];
+    let w = World::init(&d, &mut memory[S2_MISALIGN..]).unwrap();
+
+    w.add_shape(Shape::Disc { centre: [S2_DISC_X, S2_DISC_Y], radius: S2_DISC_RADIUS }, S2_DISC_E).unwrap();
+    let index = w
+        .add_emitter(Emitter {
+            min: [S2_EMIT_MIN_X, S2_EMIT_MIN_Y, 0],
+            max: [S2_EMIT_MAX_X, S2_EMIT_MAX_Y, 0],
+            rate: S2_EMIT_RATE,
+            velocity: [S2_EMIT_VX, S2_EMIT_VY, 0.0],
+            spread: S2_EMIT_SPREAD,
+            mass: 1.0,
+            lifetime: S2_EMIT_LIFETIME,
+        })
+        .unwrap();
+    assert_eq!(index, 0);
+    for i in 0..S2_PARTICLES {
+        let pos = [2 + 3 * i, S2_PARTICLE_Y, 0];
+        let v = [if i % 2 == 1 { S2_SPEED_X } else { -S2_SPEED_X }, 0.1 * (i % 3) as f32 - 0.1, 0.0];
+        w.add_particle(pos, v).unwrap();
+    }
+    w.step(S2_STEPS);
+    (w.state_hash(), w.stats())
+}
+
+// The 3D scene of tests/c/scenes.c.
+const S3_SIZE: u32 = 16;
+const S3_SEED: u64 = 99;
+const S3_GRAVITY_Y: f32 = -0.03;
+const S3_RESTITUTION: f32 = 0.8;
+const S3_SURFACES: u32 = 512;
+const S3_SPHERE_X: f32 = 8.0;
+const S3_SPHERE_Y: f32 = 6.0;
+const S3_SPHERE_Z: f32 = 8.0;
+const S3_SPHERE_RADIUS: f32 = 3.5;
+const S3_SPHERE_E: f32 = 0.9;
+const S3_BLOCK_Y: u32 = 11;
+const S3_BLOCK_XZ: u32 = 6;
+const S3_HEAVY: f32 = 2.0;
+const S3_STEPS: u64 = 30;
+
+fn scene_3d() -> (u64, Stats) {
+    let mut d = Description::new_3d(S3_SIZE, S3_SIZE, S3_SIZE);
+    d.seed = S3_SEED;
+    d.boundary = [[Boundary::Wall; 2]; 3];
+    d.forces.uniform = true;
+    d.gravity[1] = S3_GRAVITY_Y;
+    d.restitution = S3_RESTITUTION;
+    d.obstacles = true;
+    d.surface_capacity = S3_SURFACES;
+    d.per_particle_mass = true;
+    d.mass_classes = 2;
+    d.quantization = Quantization::Bits16;
+    d.drift = Drift::Calibrated;
+    d.method = Method::Greedy;
+    let mut w = WorldBox::new(&d).unwrap(); // as mpca_world_create
+
+    let centre = [S3_SPHERE_X, S3_SPHERE_Y, S3_SPHERE_Z];
+    w.add_shape(Shape::Sphere { centre, radius: S3_SPHERE_RADIUS }, S3_SPHERE_E).unwrap();
+    for y in S3_BLOCK_Y..S3_BLOCK_Y + 3 {
+        for z in S3_BLOCK_XZ..S3_BLOCK_XZ + 4 {
+            for x in S3_BLOCK_XZ..S3_BLOCK_XZ + 4 {
+                let (a, b) = ([0.2, 0.0, -0.1], [-0.1, 0.1, 0.2]);
+                let v = if (x + y + z) % 2 == 0 { a } else { b };
+                if x % 2 == 0 {
+                    w.add_particle_with_mass([x, y, z], v, S3_HEAVY).unwrap();
+                } else {
+                    w.add_particle([x, y, z], v).unwrap();
+                }
+            }
+        }
+    }
+    w.step(S3_STEPS);
+    (w.state_hash(), w.stats())
+}
+
+/// The `key=value` pairs of a `stats2d:` / `stats3d:` line.
+fn parse_stats(line: &str) -> BTreeMap<&str, u64> {
+    line.split_whitespace()
+        .map(|kv| {
+            let (k, v) = kv.split_once('=').expect("key=value");
+            (k, v.parse().expect("a count"))
+        })
+        .collect()
+}
+
+fn expected_stats(s: &Stats) -> BTreeMap<&'static str, u64> {
+    BTreeMap::from([
+        ("step", s.step),
+        ("particles", s.particles),
+        ("emitted", s.emitted),
+        ("exited", s.exited),
+        ("expired", s.expired),
+        ("shortfall", s.emit_shortfall),
+        ("collisions", s.collisions),
+        ("clamps", s.clamps),
+        ("displaced", s.displaced),
+    ])
+}
+
+#[test]
+fn scenes_stepped_from_c_equal_the_same_scenes_through_the_rust_api() {
+    let run = scenes();
+    run.assert_success();
+    for (name, (hash, stats)) in [("2d", scene_2d()), ("3d", scene_3d())] {
+        let printed = run.value(&format!("hash{name}: "));
+        let c_hash = u64::from_str_radix(printed, 16).unwrap_or_else(|_| panic!("hash{name}: {printed}"));
+        assert_eq!(c_hash, hash, "{name}: the hash from C {c_hash:016x}, from Rust {hash:016x}");
+        let c_stats = parse_stats(run.value(&format!("stats{name}: ")));
+        assert_eq!(c_stats, expected_stats(&stats), "{name}: statistics from C against Rust");
+        // The scene is not trivial: particles moved into one another.
+        assert!(stats.collisions > 0, "{name}: no collisions");
+    }
+}
+
+#[test]
+fn exports_from_c_agree_with_the_cells_and_the_density() {
+    let run = scenes();
+    run.assert_success();
+    for (name, (_, stats)) in [("2d", scene_2d()), ("3d", scene_3d())] {
+        let line = run.value(&format!("exports{name}: "));
+        let expected = format!("{} particles, consistent with mpca_world_cell and the density", stats.particles);
+        assert_eq!(line, expected, "{name}");
+    }
+}
+
+// --- Sanitizers, handle registry -------------------------------------------------
+
+#[test]
+fn sanitizers_are_linked_in_exactly_when_asked() {
+    for run in [errors(), scenes(), reuse()] {
+        let printed = run.value("sanitizer: ");
+        let needed = Elf::read(&run.exe).needed();
+        let asan = needed.iter().any(|n| n.starts_with("libasan.so"));
+        if sanitize() {
+            assert_eq!(printed, "address", "{}: built with MPCA_C_SANITIZE=1", run.name());
+            assert!(asan, "{}: no libasan among {needed:?}", run.name());
+            println!("{}: needs {}", run.name(), needed.iter().find(|n| n.starts_with("libasan")).unwrap());
+        } else {
+            assert_eq!(printed, "none", "{}", run.name());
+            assert!(!asan, "{}: libasan linked without MPCA_C_SANITIZE=1", run.name());
+        }
+        // ASan and LSan reports end the program with a failure status; say
+        // which if one is there.
+        assert!(!run.stderr.contains("Sanitizer"), "{}: sanitizer report:\n{}", run.name(), tail(&run.stderr, 60));
+    }
+}
+
+#[test]
+fn caller_memory_at_a_destroyed_worlds_address_is_a_live_world() {
+    let run = reuse();
+    // Else the check never ran: the allocator must hand the block back.
+    assert_eq!(run.value("reuse: "), "reached", "the allocator never reused the destroyed world's block");
+    run.assert_success();
+}
+
+/// The README's C example (its first ```c block), compiled with the same
+/// strict flags, linked as the README says (`-lmpca -lm`, here statically by
+/// path) and run. Expected: exit 0, and all 64 particles it adds still there
+/// after its 100 steps, falling (negative y momentum).
+#[test]
+fn the_readme_c_example_builds_and_runs() {
+    let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
+    let start = readme.find("```c\n").expect("README.md has a ```c block") + "```c\n".len();
+    let end = start + readme[start..].find("```").expect("the ```c block ends");
+    let src = out_dir().join("readme_example.c");
+    std::fs::write(&src, &readme[start..end]).unwrap();
+    let exe = out_dir().join("readme_example");
+    let mut cmd = compiler(false, false);
+    cmd.arg("-o").arg(&exe).arg(&src).arg(library().join("libmpca.a")).args(["-lm", "-lpthread", "-ldl"]);
+    let out = cmd.output().expect("the C compiler runs");
+    assert!(out.status.success(), "{}\n{}", command_line(&cmd), String::from_utf8_lossy(&out.stderr));
+    let out = Command::new(&exe).env_remove("LD_LIBRARY_PATH").output().expect("the example runs");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "exit {}: {stdout}{}", out.status, String::from_utf8_lossy(&out.stderr));
+    let line = stdout.lines().next().unwrap_or_default();
+    assert!(line.starts_with("64 particles after 100 steps, momentum y -"), "{line}");
+}
