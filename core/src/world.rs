@@ -81,7 +81,7 @@ pub(crate) struct Header {
     pub masses: u32,
     pub surfaces: u32,
     pub emitters: u32,
-    /// 1 when the library allocated the memory ([`crate::WorldBox`]).
+    /// 1 when the library allocated the memory (`WorldBox`, feature `alloc`).
     pub owned: u32,
 }
 
@@ -322,7 +322,7 @@ impl World {
     }
 
     /// Whether the library allocated this world's memory (a
-    /// [`crate::WorldBox`]), so that it, not the caller, must free it.
+    /// `WorldBox`, feature `alloc`), so that it, not the caller, must free it.
     pub fn is_owned(&self) -> bool {
         self.head.owned != 0
     }
