@@ -281,6 +281,8 @@ impl Layout {
         }
         let row_words = n[0].div_ceil(64);
         let bit_plane = row_words.checked_mul(n[1] * n[2]).and_then(|w| w.checked_mul(8)).ok_or(Error::TooLarge)?;
+        // Bit planes are indexed by bit, so their bit count must fit too.
+        bit_plane.checked_mul(8).ok_or(Error::TooLarge)?;
         let q = match d.quantization {
             Quantization::Bits8 => 1,
             Quantization::Bits16 => 2,

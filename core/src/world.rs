@@ -549,7 +549,10 @@ impl World {
 
     /// As [`World::density`], scaled to `0..=255` for a texture upload.
     pub fn density_u8(&self, res: [u32; 3], out: &mut [u8]) -> Result<(), Error> {
-        self.bin(res, out.len(), |i, hit, total| out[i] = ((hit * 255 + total / 2) / total) as u8)
+        // In u64: hit * 255 can overflow a 32-bit usize.
+        self.bin(res, out.len(), |i, hit, total| {
+            out[i] = ((hit as u64 * 255 + total as u64 / 2) / total as u64) as u8
+        })
     }
 
     fn bin(&self, res: [u32; 3], len: usize, mut put: impl FnMut(usize, usize, usize)) -> Result<(), Error> {
@@ -566,7 +569,8 @@ impl World {
             return Err(Error::BadResolution);
         }
         let occ: &[u64] = self.plane(l.occupancy);
-        let edge = |k: usize, i: usize| i * l.n[k] / r[k];
+        // In u64: i * n can overflow a 32-bit usize; the result is <= n.
+        let edge = |k: usize, i: usize| (i as u64 * l.n[k] as u64 / r[k] as u64) as usize;
         let mut i = 0;
         for bz in 0..r[2] {
             for by in 0..r[1] {
