@@ -9,15 +9,7 @@ cd "$(dirname "$0")/.."
 need=()
 command -v arm-linux-gnueabihf-gcc >/dev/null || need+=(gcc-arm-linux-gnueabihf libc6-dev-armhf-cross)
 command -v qemu-arm >/dev/null || need+=(qemu-user)
-if [ ${#need[@]} -gt 0 ]; then
-    if [ "$(id -u)" = 0 ]; then
-        DEBIAN_FRONTEND=noninteractive apt-get update -q
-        DEBIAN_FRONTEND=noninteractive apt-get install -y -q "${need[@]}"
-    else
-        echo "cross-target.sh needs: apt-get install ${need[*]}" >&2
-        exit 1
-    fi
-fi
+scripts/install-missing.sh ${need[@]+"${need[@]}"}
 rustup target list --installed | grep -qx armv7-unknown-linux-gnueabihf || rustup target add armv7-unknown-linux-gnueabihf
 
 cargo build --release -p mpca-tests --bin scene_hashes

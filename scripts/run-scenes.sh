@@ -1,0 +1,177 @@
+#!/usr/bin/env bash
+# The paper's four scenes, rendered: installs what is missing (Debian or
+# Ubuntu), builds libmpca and the C programs of c_examples/, runs the four
+# scenes at full size (and the smoke scene a second, longer time), and says
+# where the images are and how long the simulation took.
+#
+#   scripts/run-scenes.sh [--out DIR] [--docs]
+#
+#   --out DIR   where the images go (default out/scenes, git-ignored)
+#   --docs      also copy the contact sheets to docs/scenes/ and rewrite
+#               the README's scenes section (between its <!-- scenes:begin -->
+#               and <!-- scenes:end --> lines) with this machine's timings
+#
+# Needs only the Rust toolchain; make, libosmesa6-dev and libpng-dev are
+# installed with apt-get when missing (as root, or through sudo).
+set -euo pipefail
+
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+out="$root/out/scenes"
+docs=0
+while [ $# -gt 0 ]; do
+    case "$1" in
+        --out) [ $# -ge 2 ] || { echo "--out needs a folder" >&2; exit 2; }; out=$2; shift 2 ;;
+        --docs) docs=1; shift ;;
+        -h|--help) sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+        *) echo "unknown option: $1 (try --help)" >&2; exit 2 ;;
+    esac
+done
+mkdir -p "$out"
+out=$(cd "$out" && pwd)
+
+echo "== what the C programs need"
+cc=${CC:-cc}
+"$root/scripts/setup-c.sh"
+
+echo "== libmpca (cargo build --release -p mpca-ffi)"
+cd "$root"
+cargo build --release -p mpca-ffi
+target=${CARGO_TARGET_DIR:-$root/target}
+case "$target" in /*) ;; *) target="$root/$target" ;; esac
+lib="$target/release"
+bin="$target/c_examples"
+
+echo "== the C programs (make -C c_examples)"
+make -C c_examples --no-print-directory MPCA_LIB="$lib" BUILD="$bin" CC="$cc"
+
+echo "== the scenes, full size, images in $out"
+logs=$(mktemp -d)
+trap 'rm -rf "$logs"' EXIT
+runs=(aggregation cluster smoke water smoke-long)
+for run in "${runs[@]}"; do
+    case "$run" in
+        smoke-long) args=(smoke --steps 480 --every 40 --name smoke-long) ;;
+        *) args=("$run") ;;
+    esac
+    echo "-- ${args[*]}"
+    "$bin/${args[0]}" "${args[@]:1}" --out "$out" | tee "$logs/$run.log"
+done
+
+# One row per run: the program's own figures.
+cpu=$(awk -F': ' '/^model name/{print $2; exit}' /proc/cpuinfo 2>/dev/null || true)
+cores=$(nproc 2>/dev/null || echo "?")
+machine="${cpu:-unknown CPU}, $cores cores"
+summary() {
+    for run in "${runs[@]}"; do
+        awk -v run="$run" '
+            NR == 1 { match($0, /[0-9x]+ cells/); cells = substr($0, RSTART, RLENGTH - 6) }
+            /^end: / { for (i = 2; i <= NF; i++) { split($i, kv, "="); e[kv[1]] = kv[2] } }
+            /^sim: / { per_step = $2; match($0, /in [0-9.]+ ms/); total = substr($0, RSTART + 3, RLENGTH - 6) }
+            /^sheet: / { sheet = $2 }
+            END { printf "%s|%s|%s|%s|%s|%s|%s\n", run, cells, e["particles"], e["step"], per_step, total, sheet }
+        ' "$logs/$run.log"
+    done
+}
+echo
+echo "== done: simulation time on $machine (rendering and PNG writing not included)"
+printf '%-12s %-8s %10s %6s %10s %10s  %s\n' scene cells particles steps ms/step total_ms "contact sheet"
+summary | while IFS='|' read -r run cells particles steps per_step total sheet; do
+    printf '%-12s %-8s %10s %6s %10s %10s  %s\n' "$run" "$cells" "$particles" "$steps" "$per_step" "$total" "$sheet"
+done
+echo
+echo "frames and contact sheets: $out"
+
+if [ "$docs" -eq 1 ]; then
+    echo "== docs/scenes and the README's scenes section"
+    mkdir -p "$root/docs/scenes"
+    for run in "${runs[@]}"; do
+        sheet="$out/$run-sheet.png"
+        # Keep committed images small: re-render at half the resolution
+        # while the sheet is over 300 KB.
+        px=512
+        while [ "$(stat -c %s "$sheet")" -gt 307200 ] && [ $px -gt 64 ]; do
+            px=$((px / 2))
+            small="$logs/px$px"
+            case "$run" in
+                smoke-long) "$bin/smoke" --steps 480 --every 0 --name smoke-long --px $px --out "$small" >/dev/null ;;
+                *) "$bin/$run" --every 0 --px $px --out "$small" >/dev/null ;;
+            esac
+            sheet="$small/$run-sheet.png"
+        done
+        cp "$sheet" "$root/docs/scenes/$run.png"
+        echo "docs/scenes/$run.png: $(stat -c %s "$sheet") bytes"
+    done
+    paper_s() { case "$1" in aggregation) echo 800;; cluster) echo 70;; smoke) echo 8;; water) echo 270;; *) echo "";; esac; }
+    section() { case "$1" in aggregation) echo "4.1 aggregation";; cluster) echo "4.2 cluster collision";;
+        smoke) echo "4.3 smoke";; water) echo "4.4 water";; smoke-long) echo "4.3 smoke, longer run";; esac; }
+    caption() { case "$1" in
+        aggregation) echo "a gas at density 0.3 with e = 0.5 cools and gathers into clusters (slow, blue);";;
+        cluster) echo "two discs meet at v = (±0.8, 0) and scatter, mostly across the line of flight;";;
+        smoke) echo "one particle a step rises from the ground and the vortex (grey guides) bends the plume;";;
+        water) echo "water poured on the sphere splashes off it and spreads over the floor;";;
+        smoke-long) echo "the same smoke for 480 steps: the vortex bends the plume round its right side and flings it out at the top right.";;
+    esac; }
+    # 12345 -> 12,345
+    commas() { echo "$1" | sed ':a;s/\B[0-9]\{3\}\>/,&/;ta'; }
+    {
+        echo "## The paper's scenes, rendered"
+        echo
+        echo "The four scenes of the paper's section 4, as C programs in \`c_examples/\`"
+        echo "that use only \`include/mpca.h\` and \`libmpca\`, drawn off-screen with OpenGL"
+        echo "through OSMesa (no window, no display) and written as PNG with libpng."
+        echo "Particles are coloured by speed (2D: blue slow, through green and yellow,"
+        echo "to red at 1 cell per step; 3D: dark blue to light cyan, darker farther"
+        echo "away); walls, the sphere and the vortex's guide circles are grey."
+        echo "Each program writes a frame every few steps and one contact sheet:"
+        echo
+        echo "<!-- scenes: the main command -->"
+        echo '```sh'
+        echo "scripts/run-scenes.sh"
+        echo '```'
+        echo
+        echo "It installs what is missing (\`make\`, \`libosmesa6-dev\`, \`libpng-dev\`,"
+        echo "with \`apt-get\` as root or through \`sudo\`), builds \`libmpca\` in release"
+        echo "mode and the programs with \`make\`, runs the four scenes at full size (and"
+        echo "the smoke scene a second time, for 480 steps) and prints where the images"
+        echo "are: \`out/scenes/\`. Each program also runs alone, e.g."
+        echo "\`target/c_examples/water --size 32 --steps 200 --every 20 --out /tmp/w\`;"
+        echo "\`--help\` lists its options (\`--size --steps --seed --every --tiles --px --out --name\`)."
+        echo
+        for run in "${runs[@]}"; do
+            echo "**$(section "$run")**: $(caption "$run")"
+            echo
+            echo "![$(section "$run"): contact sheet](docs/scenes/$run.png)"
+            echo
+        done
+        echo "Simulation time only (\`mpca_world_step\`; building the world, drawing and"
+        echo "writing PNGs not included), one run each, on $machine,"
+        echo "beside the paper's time on a Sun SPARCstation 2GS:"
+        echo
+        echo "| scene | cells | particles (end) | steps | this library, per step | this library, total | paper (SPARCstation 2GS) | paper / this |"
+        echo "|---|---|---|---|---|---|---|---|"
+        summary | while IFS='|' read -r run cells particles steps per_step total _; do
+            p=$(paper_s "$run")
+            if [ -n "$p" ]; then
+                ratio=$(awk -v p="$p" -v t="$total" 'BEGIN { r = p * 1000 / t; e = 10 ^ (int(log(r) / log(10)) - 1); printf "%d", int(r / e + 0.5) * e }')
+                paper="~$p s"; ratio="~$(commas "$ratio")×"
+            else
+                paper="—"; ratio="—"
+            fi
+            echo "| $(section "$run") | ${cells//x/ × } | $(commas "$particles") | $steps | $per_step ms | $total ms | $paper | $ratio |"
+        done
+        echo
+        echo "The scenes are those of \`tests/src/scenes.rs\` (sizes, seeds, boundaries,"
+        echo "forces, emitters, obstacles, step counts): \`cargo test\` runs each C program"
+        echo "for a few steps at full size and checks that its world hashes equal to the"
+        echo "Rust scene's, and runs each at a small size and checks its images."
+    } > "$logs/section.md"
+    # Splice the section into README.md between its markers.
+    awk -v section="$logs/section.md" '
+        /^<!-- scenes:end -->$/ { skip = 0 }
+        !skip { print }
+        /^<!-- scenes:begin -->$/ { while ((getline line < section) > 0) print line; skip = 1 }
+    ' "$root/README.md" > "$logs/README.md"
+    grep -q '^<!-- scenes:end -->$' "$logs/README.md" || { echo "README.md lacks the scenes markers" >&2; exit 1; }
+    cp "$logs/README.md" "$root/README.md"
+    echo "README.md: scenes section rewritten"
+fi

@@ -1,0 +1,21 @@
+#!/usr/bin/env bash
+# Makes sure the C side can build: a C compiler, make, and the OSMesa and
+# libpng headers the rendered scenes (c_examples/) use; installs what is
+# missing (scripts/install-missing.sh).
+set -euo pipefail
+here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
+cc=${CC:-cc}
+missing=()
+command -v make >/dev/null 2>&1 || missing+=(make)
+if ! command -v "$cc" >/dev/null 2>&1; then
+    missing+=(gcc libc6-dev libosmesa6-dev libpng-dev)
+else
+    header() { printf '#include <%s>\n' "$1" | "$cc" -E -x c - >/dev/null 2>&1; }
+    header GL/osmesa.h || missing+=(libosmesa6-dev)
+    header png.h || missing+=(libpng-dev)
+fi
+if [ ${#missing[@]} -gt 0 ]; then
+    "$here/install-missing.sh" "${missing[@]}"
+else
+    echo "make, $cc, OSMesa and libpng headers: present"
+fi

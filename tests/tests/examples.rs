@@ -1,0 +1,378 @@
+//! The C scene programs of `c_examples/`: the paper's four scenes rendered
+//! off-screen with OSMesa and written as PNG with libpng. Built with their
+//! own Makefile against the real `libmpca.a`, run, and their images read
+//! back through `pngstat` (c_examples/pngstat.c, also libpng), so this
+//! needs no image crate.
+//!
+//! - Each program runs a few steps at a small size; every frame and the
+//!   contact sheet must have the size the program printed, and the pixels
+//!   must account for the particles it reported (bands derived below).
+//! - Each program runs a few steps at the paper's size, and its world's
+//!   hash must equal that of the same scene built by `tests/src/scenes.rs`:
+//!   the C scenes are the Rust scenes, placement and seeds included.
+//!
+//! Needs `make`, a C compiler and the OSMesa and libpng headers; the test
+//! fails, naming the packages, when they are missing.
+#![cfg(target_os = "linux")]
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::sync::OnceLock;
+
+use mpca_tests::scenes::{Scene, build, paper_scenes};
+
+/// What to install when the headers are missing (Debian, Ubuntu).
+const INSTALL: &str = "apt-get install -y libosmesa6-dev libpng-dev";
+
+fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR")).parent().expect("tests/ lies in the workspace")
+}
+
+/// The directory holding `libmpca.a`: the same nested cargo build, into the
+/// same target directory and with the same features, as tests/c_abi.rs, so
+/// the two test programs share one build of the library instead of paying
+/// for two (mpca_debug_panic, which `panic-test` adds, goes unused here).
+fn library() -> &'static Path {
+    static DIR: OnceLock<PathBuf> = OnceLock::new();
+    DIR.get_or_init(|| {
+        let target_dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("ffi");
+        let cargo = std::env::var_os("CARGO").unwrap_or_else(|| env!("CARGO").into());
+        let out = Command::new(cargo)
+            .current_dir(root())
+            .args(["build", "--release", "-p", "mpca-ffi", "--features", "panic-test", "--target-dir"])
+            .arg(&target_dir)
+            .output()
+            .expect("cargo runs");
+        assert!(out.status.success(), "building libmpca failed:\n{}", String::from_utf8_lossy(&out.stderr));
+        let dir = target_dir.join("release");
+        assert!(dir.join("libmpca.a").is_file(), "libmpca.a missing from {}", dir.display());
+        dir
+    })
+}
+
+/// The C compiler cc picks for this target.
+fn c_compiler() -> cc::Tool {
+    cc::Build::new()
+        .cargo_metadata(false)
+        .cargo_warnings(false)
+        .target(env!("MPCA_TEST_TARGET"))
+        .host(env!("MPCA_TEST_HOST"))
+        .opt_level(2)
+        .get_compiler()
+}
+
+/// Fails with what to install when make or the headers are missing.
+fn check_build_dependencies(cc: &cc::Tool, dir: &Path) {
+    let make = Command::new("make").arg("--version").output();
+    assert!(
+        make.is_ok_and(|o| o.status.success()),
+        "`make` is missing; the C examples need it and the OSMesa and libpng headers: apt-get install -y make \
+         libosmesa6-dev libpng-dev"
+    );
+    let probe = dir.join("probe.c");
+    std::fs::write(
+        &probe,
+        "#include <GL/gl.h>\n#include <GL/osmesa.h>\n#include <png.h>\nint main(void) { return 0; }\n",
+    )
+    .expect("write the probe");
+    let out = cc.to_command().arg("-fsyntax-only").arg(&probe).output().expect("the C compiler runs");
+    assert!(
+        out.status.success(),
+        "the C examples need the OSMesa and libpng headers, which {} cannot find: {INSTALL}\n{}",
+        cc.path().display(),
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+/// The folder holding the four programs and pngstat, built once per test
+/// process by `make` in c_examples/ (which compiles with -std=c99 -Wall
+/// -Wextra -Wpedantic -Werror).
+fn programs() -> &'static Path {
+    static DIR: OnceLock<PathBuf> = OnceLock::new();
+    DIR.get_or_init(|| {
+        let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("c_examples");
+        std::fs::create_dir_all(&dir).expect("create the build folder");
+        let cc = c_compiler();
+        check_build_dependencies(&cc, &dir);
+        let lib = library();
+        let out = Command::new("make")
+            .current_dir(root().join("c_examples"))
+            .arg(format!("MPCA_LIB={}", lib.display()))
+            .arg(format!("BUILD={}", dir.display()))
+            .arg(format!("CC={}", cc.path().display()))
+            .output()
+            .expect("make runs");
+        assert!(
+            out.status.success(),
+            "make in c_examples failed ({INSTALL} installs the libraries it needs):\n{}\n{}",
+            String::from_utf8_lossy(&out.stdout),
+            String::from_utf8_lossy(&out.stderr)
+        );
+        dir
+    })
+}
+
+/// Runs a scene program; its stdout on success.
+fn run(scene: &str, args: &[&str]) -> String {
+    let exe = programs().join(scene);
+    let out = Command::new(&exe).args(args).output().expect("the scene program runs");
+    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(
+        out.status.success(),
+        "{scene} {} exited with {}:\n{stdout}{}",
+        args.join(" "),
+        out.status,
+        String::from_utf8_lossy(&out.stderr)
+    );
+    stdout
+}
+
+/// The `key=value` fields of a line.
+fn fields(line: &str) -> BTreeMap<&str, &str> {
+    line.split_whitespace().filter_map(|kv| kv.split_once('=')).collect()
+}
+
+fn number<T: std::str::FromStr>(f: &BTreeMap<&str, &str>, key: &str, line: &str) -> T {
+    f.get(key).and_then(|v| v.parse().ok()).unwrap_or_else(|| panic!("no number {key}= in `{line}`"))
+}
+
+/// `WxH`.
+fn dims(f: &BTreeMap<&str, &str>, line: &str) -> (u64, u64) {
+    let s = f.get("size").unwrap_or_else(|| panic!("no size= in `{line}`"));
+    let (w, h) = s.split_once('x').unwrap_or_else(|| panic!("size={s}"));
+    (w.parse().unwrap(), h.parse().unwrap())
+}
+
+/// What pngstat counted in one PNG.
+#[derive(Debug)]
+struct Pixels {
+    width: u64,
+    height: u64,
+    /// Pixels that differ from the background.
+    nonbg: u64,
+    /// Pixels in a saturated colour: particles (everything else is grey).
+    coloured: u64,
+}
+
+fn pngstat(path: &Path) -> Pixels {
+    let out = Command::new(programs().join("pngstat")).arg(path).output().expect("pngstat runs");
+    let line = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(out.status.success(), "pngstat {}: {}", path.display(), String::from_utf8_lossy(&out.stderr));
+    let f = fields(&line);
+    Pixels {
+        width: number(&f, "width", &line),
+        height: number(&f, "height", &line),
+        nonbg: number(&f, "nonbg", &line),
+        coloured: number(&f, "coloured", &line),
+    }
+}
+
+/// One image a program reported: a `frame:` line (a PNG of its own) or a
+/// `tile:` line (a part of the contact sheet).
+#[derive(Debug)]
+struct Drawn {
+    path: Option<PathBuf>,
+    step: u64,
+    particles: u64,
+    width: u64,
+    height: u64,
+    /// 2D: the side of a particle's square, in pixels.
+    point_px: Option<u64>,
+    /// 3D: the largest sprite diameter, in pixels.
+    sprite_max_px: Option<f64>,
+}
+
+fn drawn(line: &str) -> Drawn {
+    let f = fields(line);
+    let (width, height) = dims(&f, line);
+    Drawn {
+        path: line.strip_prefix("frame: ").map(|r| PathBuf::from(r.split_whitespace().next().unwrap())),
+        step: number(&f, "step", line),
+        particles: number(&f, "particles", line),
+        width,
+        height,
+        point_px: f.get("point_px").map(|v| v.parse().expect("point_px")),
+        sprite_max_px: f.get("sprite_px").map(|v| v.split_once("..").expect("min..max").1.parse().expect("max")),
+    }
+}
+
+/// Bounds on the particle pixels of one image, from the particles drawn.
+///
+/// 2D: no two particles share a cell (M1) and each is a square point of
+/// `point_px` pixels inside its cell, drawn last in a saturated colour, so
+/// the coloured pixels are exactly `particles * point_px^2`.
+/// 3D: sprites overlap and hide one another, so the count lies between one
+/// pixel (something is drawn when a particle exists) and `particles`
+/// sprites of the largest size the box allows, rounded up, plus one pixel
+/// of rasterisation slack per side.
+fn particle_pixels(d: &Drawn) -> (u64, u64) {
+    match (d.point_px, d.sprite_max_px) {
+        (Some(s), None) => (d.particles * s * s, d.particles * s * s),
+        (None, Some(max)) => {
+            let side = max.ceil() as u64 + 1;
+            (d.particles.min(1), d.particles * side * side)
+        }
+        _ => panic!("{d:?} gives neither point_px nor sprite_px"),
+    }
+}
+
+/// Pixels of the fixed parts of a frame (walls, obstacles, guides: all
+/// grey) that a scene draws, for frames of `w x h`.
+#[derive(Clone, Copy, Debug)]
+enum Fixed {
+    /// Nothing but particles (aggregation: periodic, no obstacles).
+    Nothing,
+    /// A wall two pixels wide along every border (cluster).
+    Border,
+    /// Measured from the frame at step 0, which must hold no particle
+    /// (smoke, water: emitters place their first particles in step 1),
+    /// and must cover more than nothing and at most this share.
+    AtStepZero(f64),
+}
+
+/// A small run of `scene`: every frame and the sheet checked.
+///
+/// Per frame, with C the coloured pixels and F the fixed pixels: particles
+/// are drawn over the fixed parts and are never the background, so
+/// `nonbg = |fixed ∪ particles|` lies in `[max(F, C), F + C]`.
+fn check_small_run(scene: &str, size: u32, steps: u32, every: u32, fixed: Fixed) {
+    let out_dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("examples").join(scene);
+    let _ = std::fs::remove_dir_all(&out_dir);
+    let (size_s, steps_s, every_s) = (size.to_string(), steps.to_string(), every.to_string());
+    let out_s = out_dir.to_string_lossy().into_owned();
+    let px = "256";
+    let stdout = run(
+        scene,
+        &["--size", &size_s, "--steps", &steps_s, "--every", &every_s, "--tiles", "4", "--px", px, "--out", &out_s],
+    );
+    println!("{stdout}");
+    assert!(stdout.lines().any(|l| l.starts_with("sim: ") && l.contains(" ms/step") && l.contains("render: ")));
+
+    let frames: Vec<Drawn> = stdout.lines().filter(|l| l.starts_with("frame: ")).map(drawn).collect();
+    let tiles: Vec<Drawn> = stdout.lines().filter(|l| l.starts_with("tile: ")).map(drawn).collect();
+    let expected_frames = (steps / every + u32::from(steps % every != 0) + 1) as usize;
+    assert_eq!(frames.len(), expected_frames, "{scene}: frames at every {every} steps and at the end");
+    assert_eq!(tiles.len(), 4, "{scene}: contact sheet tiles");
+    assert_eq!((tiles[0].step, tiles[3].step), (0, u64::from(steps)), "{scene}: the sheet spans the run");
+
+    let zero = pngstat(frames[0].path.as_ref().unwrap());
+    let fixed_px = match fixed {
+        Fixed::Nothing => 0,
+        Fixed::Border => 4 * (zero.width + zero.height) - 16,
+        Fixed::AtStepZero(max_share) => {
+            assert_eq!(frames[0].particles, 0, "{scene}: step 0 should hold no particle");
+            let share = zero.nonbg as f64 / (zero.width * zero.height) as f64;
+            assert!(zero.nonbg > 0 && share <= max_share, "{scene}: fixed parts cover {share:.4} of the frame");
+            zero.nonbg
+        }
+    };
+    for d in &frames {
+        let path = d.path.as_ref().unwrap();
+        let p = pngstat(path);
+        assert_eq!((p.width, p.height), (d.width, d.height), "{}: dimensions", path.display());
+        if d.point_px.is_some() {
+            // 2D frames are whole cells: size x cell_px, cell_px = px / size.
+            let cell_px = 256 / u64::from(size);
+            assert_eq!(p.width, u64::from(size) * cell_px, "{}: width", path.display());
+        } else {
+            assert_eq!(p.width, 256, "{}: width", path.display());
+        }
+        let (lo, hi) = particle_pixels(d);
+        assert!(
+            (lo..=hi).contains(&p.coloured),
+            "{}: {} particle pixels for {} particles, expected {lo}..={hi}",
+            path.display(),
+            p.coloured,
+            d.particles
+        );
+        assert!(
+            p.nonbg >= p.coloured.max(fixed_px) && p.nonbg <= p.coloured + fixed_px,
+            "{}: {} non-background pixels, {} of them particles, {fixed_px} fixed",
+            path.display(),
+            p.nonbg,
+            p.coloured
+        );
+    }
+    assert!(frames.last().unwrap().particles > 0, "{scene}: no particles at the end");
+
+    // The sheet: the tiles side by side, their particles and nothing else
+    // coloured (labels and gaps are grey or background).
+    let sheet_line = stdout.lines().find(|l| l.starts_with("sheet: ")).expect("a sheet: line");
+    let f = fields(sheet_line);
+    let sheet = PathBuf::from(sheet_line["sheet: ".len()..].split_whitespace().next().unwrap());
+    let p = pngstat(&sheet);
+    assert_eq!((p.width, p.height), dims(&f, sheet_line), "{}: dimensions", sheet.display());
+    let (tw, th) = (tiles[0].width, tiles[0].height);
+    assert!(p.width >= 4 * tw && p.height >= th, "{}: 4 tiles of {tw}x{th} do not fit", sheet.display());
+    let (lo, hi) = tiles.iter().map(particle_pixels).fold((0, 0), |(a, b), (l, h)| (a + l, b + h));
+    assert!(
+        (lo..=hi).contains(&p.coloured),
+        "{}: {} particle pixels, expected {lo}..={hi}",
+        sheet.display(),
+        p.coloured
+    );
+    assert!(p.nonbg > p.coloured, "{}: no labels or fixed parts drawn", sheet.display());
+}
+
+#[test]
+fn aggregation_small_run_draws_every_particle() {
+    check_small_run("aggregation", 32, 20, 10, Fixed::Nothing);
+}
+
+#[test]
+fn cluster_small_run_draws_every_particle_and_the_walls() {
+    check_small_run("cluster", 32, 20, 10, Fixed::Border);
+}
+
+#[test]
+fn smoke_small_run_draws_every_particle_the_vortex_and_the_ground() {
+    // Rings of radius 1, 2 and 3 core radii (3 x 10/128 of the side), one
+    // pixel wide, the ground, the emitter: well under 10 % of the frame.
+    check_small_run("smoke", 32, 30, 10, Fixed::AtStepZero(0.10));
+}
+
+#[test]
+fn water_small_run_draws_the_sphere_the_box_and_the_water() {
+    // The floor seen from above covers about a quarter of the frame, the
+    // sphere a twentieth: under half in any case.
+    check_small_run("water", 32, 40, 10, Fixed::AtStepZero(0.5));
+}
+
+/// Each program at the paper's size for a few steps: the same world, bit for
+/// bit (`mpca_world_hash` against `World::state_hash`), as the scene of
+/// tests/src/scenes.rs after the same steps.
+#[test]
+fn the_c_scenes_are_the_rust_scenes() {
+    const STEPS: u64 = 6;
+    let out_dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("examples").join("paper-size");
+    let out_s = out_dir.to_string_lossy().into_owned();
+    let scenes: Vec<Scene> = paper_scenes().into();
+    let mut memory = Vec::new();
+    for scene in &scenes {
+        let stdout = run(scene.name, &["--steps", &STEPS.to_string(), "--every", "0", "--tiles", "1", "--out", &out_s]);
+        let line = stdout.lines().find(|l| l.starts_with("end: ")).expect("an end: line");
+        let f = fields(line);
+        let world = build(scene, &mut memory).expect("the Rust scene builds");
+        world.step(STEPS);
+        assert_eq!(number::<u64>(&f, "step", line), STEPS, "{}", scene.name);
+        assert_eq!(number::<u64>(&f, "particles", line), world.particle_count(), "{}: particles", scene.name);
+        let hash = u64::from_str_radix(f["hash"], 16).expect("a hex hash");
+        assert_eq!(hash, world.state_hash(), "{}: C {hash:016x}, Rust {:016x}", scene.name, world.state_hash());
+    }
+}
+
+#[test]
+fn every_program_documents_and_checks_its_options() {
+    for scene in ["aggregation", "cluster", "smoke", "water"] {
+        let help = run(scene, &["--help"]);
+        for option in ["--size N", "--steps N", "--seed N", "--every N", "--tiles N", "--px N", "--out DIR", "--name S"]
+        {
+            assert!(help.contains(option), "{scene} --help does not mention {option}:\n{help}");
+        }
+        for bad in [&["--size", "7"][..], &["--steps", "-1"], &["--bogus"], &["--every"]] {
+            let out = Command::new(programs().join(scene)).args(bad).output().expect("runs");
+            assert_eq!(out.status.code(), Some(2), "{scene} {bad:?} should be refused");
+        }
+    }
+}
