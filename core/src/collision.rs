@@ -99,8 +99,12 @@ pub(crate) fn clamp(v: &mut [f32; 3], m: f32) -> Option<f64> {
                 0.0
             } else if big.is_infinite() {
                 if c.is_infinite() { c.signum() } else { 0.0 }
-            } else {
+            } else if big > 1.0 {
                 *c / big
+            } else {
+                // Only a NaN made the length undefined; what is left is
+                // already short enough and keeps its size.
+                *c
             };
         }
         let _ = clamp(v, m);
@@ -177,6 +181,7 @@ mod tests {
             ([f32::NEG_INFINITY, f32::INFINITY, 0.0], [-core::f32::consts::FRAC_1_SQRT_2, core::f32::consts::FRAC_1_SQRT_2, 0.0]),
             ([3e38, 3e38, 0.0], [core::f32::consts::FRAC_1_SQRT_2, core::f32::consts::FRAC_1_SQRT_2, 0.0]),
             ([f32::NAN, 0.0, 2.0], [0.0, 0.0, 1.0]),
+            ([f32::NAN, 0.25, 0.0], [0.0, 0.25, 0.0]),
             ([f32::NAN, f32::NAN, f32::NAN], [0.0, 0.0, 0.0]),
         ] {
             let mut u = v;

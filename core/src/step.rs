@@ -193,8 +193,15 @@ impl<Q: Quant, const D: usize, const OBST: bool, const FORCE: u8, const MASS: bo
                 let dv = if FORCE == FORCE_UNIFORM {
                     self.dv
                 } else {
-                    self.terms.accel(b.pos[c], b.site[c].cell, b.mass[c]).map(|a| a * self.dt_q)
+                    // dt = 0 means no change, even for an infinite force
+                    // (0 * inf would be NaN).
+                    self.terms.accel(b.pos[c], b.site[c].cell, b.mass[c]).map(|a| if self.dt_q == 0.0 { 0.0 } else { a * self.dt_q })
                 };
+                // A force that changes nothing is no step 1: a zero-valued
+                // part gives the same world as a world without it (M9).
+                if dv == [0.0; 3] {
+                    continue;
+                }
                 for k in 0..D {
                     b.v[c][k] += dv[k];
                 }

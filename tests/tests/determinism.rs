@@ -224,3 +224,50 @@ fn queries_and_step_batching_change_nothing() {
     }
     same(a, b, "batched vs single steps");
 }
+
+/// M9: planes for parts a scene does not use change nothing but memory. The
+/// paper's scenes run in a world that also enables per-particle masses,
+/// obstacles (none placed), lifetimes (none given), emitter room, and every
+/// force term at zero strength (zero gravity, an all-zero field and
+/// potential, a vortex of zero circulation). Expected: the same hash after
+/// every step as the same scene in its own lean world, and more bytes per
+/// cell.
+#[test]
+fn unused_parts_change_nothing_but_memory() {
+    for scene in mpca_tests::scenes::paper_scenes() {
+        let mut lean_mem = Vec::new();
+        let lean = mpca_tests::scenes::build(&scene, &mut lean_mem).unwrap();
+        let mut d = scene.desc;
+        d.per_particle_mass = true;
+        d.mass_classes = 8;
+        if !d.obstacles {
+            d.obstacles = true;
+            d.surface_capacity = 16;
+        }
+        d.lifetimes = true;
+        d.emitter_capacity += 2;
+        if !d.forces.uniform {
+            d.forces.uniform = true;
+            d.gravity = [0.0; 3];
+        }
+        d.forces.field = true;
+        d.forces.potential = true;
+        if !d.forces.vortex {
+            d.forces.vortex = true;
+            d.vortex = Vortex { centre: [3.0, 5.0], core_radius: 2.0, circulation: 0.0 };
+        }
+        let full_scene = mpca_tests::scenes::Scene { desc: d, ..scene };
+        let mut full_mem = Vec::new();
+        let full = mpca_tests::scenes::build(&full_scene, &mut full_mem).unwrap();
+        let cells: usize = d.size[..d.dim as usize].iter().map(|&s| s as usize).product();
+        full.set_force_field(&vec![0.0; cells * d.dim as usize]).unwrap();
+        full.set_potential(&vec![0.0; cells]).unwrap();
+        assert!(full.bytes_per_cell() > lean.bytes_per_cell());
+        for step in 0..scene.steps.min(200) {
+            assert_eq!(full.state_hash(), lean.state_hash(), "{}: worlds differ after {step} steps", scene.name);
+            full.step(1);
+            lean.step(1);
+        }
+        assert_eq!(full.stats().clamps, lean.stats().clamps, "{}", scene.name);
+    }
+}
