@@ -2,4 +2,8 @@
 //! scenes (MODEL.md table, paper section 4) built through the public API.
 #![deny(missing_docs)]
 
+pub mod json;
+pub mod measure;
+pub mod plot;
 pub mod scenes;
+pub mod table;
