@@ -6,4 +6,5 @@ pub mod json;
 pub mod measure;
 pub mod plot;
 pub mod scenes;
+pub mod setup;
 pub mod table;

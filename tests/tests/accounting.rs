@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{memory, TestRng};
+use common::memory;
 use mpca::{Boundary, Description, Emitter, Shape, World};
 
 /// Checks, after a step, the invariants of M6 and M10:
@@ -26,7 +26,7 @@ fn check_books(world: &World, initial: u64, lifetime: u16, step: u64) {
 /// Places about `density` of the free cells with random velocities of speed
 /// at most 0.8, returning how many were placed.
 fn scatter(world: &mut World, desc: &Description, density: f32, seed: u64) -> u64 {
-    let mut rng = TestRng::new(seed);
+    let mut rng = common::test_rng(seed);
     let mut placed = 0;
     for pos in common::cells(desc) {
         if rng.unit() < density && !world.obstacle_at(pos) {
@@ -256,7 +256,7 @@ fn density_bins_count_particles() {
     let desc = Description::new_3d(16, 8, 4);
     let mut mem = memory(&desc);
     let world = World::init(&desc, &mut mem).unwrap();
-    let mut rng = TestRng::new(71);
+    let mut rng = common::test_rng(71);
     let cells: Vec<[u32; 3]> = common::cells(&desc).collect();
     for &pos in &cells {
         if rng.unit() < 0.35 {

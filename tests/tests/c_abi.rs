@@ -16,10 +16,14 @@
 //! ELF inspection and the link flags assume Linux.
 #![cfg(target_os = "linux")]
 
+mod clib;
+
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::OnceLock;
+
+use clib::{library, root};
 
 use mpca::{Boundary, Description, Drift, Emitter, Method, Quantization, Shape, Stats, World, WorldBox};
 
@@ -29,40 +33,8 @@ const MIN_ERROR_CASES: u64 = 1700;
 
 const SANITIZE_FLAGS: [&str; 3] = ["-fsanitize=address,undefined", "-fno-omit-frame-pointer", "-fno-sanitize-recover=all"];
 
-fn root() -> &'static Path {
-    Path::new(env!("CARGO_MANIFEST_DIR")).parent().expect("tests/ lies in the workspace")
-}
-
 fn sanitize() -> bool {
     std::env::var("MPCA_C_SANITIZE").is_ok_and(|v| v == "1")
-}
-
-/// The directory holding `libmpca.a` and `libmpca.so`, built once per test
-/// process with the `panic-test` feature (for `mpca_debug_panic`).
-///
-/// A nested cargo, because the C programs need the real libraries: mpca-ffi
-/// is a staticlib and a cdylib with no rlib, so this crate cannot depend on
-/// it and the outer build never produces them for the tests. Its own target
-/// directory keeps it off the build directory lock that the outer `cargo
-/// test` holds while the tests run.
-fn library() -> &'static Path {
-    static DIR: OnceLock<PathBuf> = OnceLock::new();
-    DIR.get_or_init(|| {
-        let target_dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("ffi");
-        let cargo = std::env::var_os("CARGO").unwrap_or_else(|| env!("CARGO").into());
-        let out = Command::new(cargo)
-            .current_dir(root())
-            .args(["build", "--release", "-p", "mpca-ffi", "--features", "panic-test", "--target-dir"])
-            .arg(&target_dir)
-            .output()
-            .expect("cargo runs");
-        assert!(out.status.success(), "building libmpca failed:\n{}", String::from_utf8_lossy(&out.stderr));
-        let dir = target_dir.join("release");
-        for lib in ["libmpca.a", "libmpca.so"] {
-            assert!(dir.join(lib).is_file(), "{lib} missing from {}", dir.display());
-        }
-        dir
-    })
 }
 
 /// Where the C programs go; sanitized builds apart from plain ones.

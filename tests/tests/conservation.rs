@@ -18,7 +18,7 @@
 
 mod common;
 
-use common::{memory, quanta, scale, TestRng, Z};
+use common::{memory, quanta, scale, Z};
 use mpca::{Description, Quantization, World};
 
 /// 2^-24, the unit roundoff of f32.
@@ -113,7 +113,7 @@ fn closed_box(sc: &Scene) -> Outcome {
     desc.mass_classes = sc.masses.len() as u32;
     let mut mem = memory(&desc);
     let world = World::init(&desc, &mut mem).unwrap();
-    let mut rng = TestRng::new(sc.seed);
+    let mut rng = common::test_rng(sc.seed);
     let nz = if dim == 3 { n } else { 1 };
     let mut placed = 0;
     while placed < sc.count {
@@ -347,7 +347,7 @@ fn stored_speeds_stay_within_a_quantum_of_one() {
         desc.seed = 33;
         let mut mem = memory(&desc);
         let world = World::init(&desc, &mut mem).unwrap();
-        let mut rng = TestRng::new(33);
+        let mut rng = common::test_rng(33);
         for pos in common::cells(&desc) {
             if rng.unit() < 0.4 {
                 world.add_particle(pos, rng.velocity(dim, 1.0)).unwrap();

@@ -95,32 +95,13 @@ fn periodic_faces_come_in_pairs() {
     assert_eq!(d.validate(), Ok(()));
 }
 
-/// Sets one float of a description.
-type Setter = fn(&mut Description, f32);
-
 /// M1: every float the description holds is finite. Expected: NaN, +inf or
 /// -inf in the mass, either restitution, dt, any gravity component or any
 /// vortex parameter is NotFinite.
 #[test]
 fn floats_must_be_finite() {
     for bad in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
-        let cases: [(&str, Setter); 12] = [
-            ("mass", |d, v| d.mass = v),
-            ("restitution", |d, v| d.restitution = v),
-            ("wall_restitution", |d, v| d.wall_restitution = v),
-            ("dt", |d, v| d.dt = v),
-            ("gravity x", |d, v| d.gravity[0] = v),
-            ("gravity y", |d, v| d.gravity[1] = v),
-            ("gravity z", |d, v| d.gravity[2] = v),
-            ("vortex centre x", |d, v| d.vortex.centre[0] = v),
-            ("vortex centre y", |d, v| d.vortex.centre[1] = v),
-            ("vortex core radius", |d, v| d.vortex.core_radius = v),
-            ("vortex circulation", |d, v| d.vortex.circulation = v),
-            ("vortex circulation (vortex on)", |d, v| {
-                d.forces.vortex = true;
-                d.vortex.circulation = v;
-            }),
-        ];
+        let cases = common::description_floats();
         for (name, set) in cases {
             let mut d = base();
             d.forces.uniform = true;

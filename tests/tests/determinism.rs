@@ -5,7 +5,6 @@
 
 mod common;
 
-use common::TestRng;
 use mpca::{Boundary, Description, Drift, Emitter, Method, Quantization, Shape, Stats, Vortex, World};
 
 /// The boundary kinds a configuration can have.
@@ -63,7 +62,7 @@ struct Inputs {
 }
 
 fn inputs(desc: &Description, seed: u64) -> Inputs {
-    let mut rng = TestRng::new(seed);
+    let mut rng = common::test_rng(seed);
     let cells: Vec<[u32; 3]> = common::cells(desc).collect();
     let masses = [1.0f32, 2.0, 0.5];
     let mut particles = vec![];

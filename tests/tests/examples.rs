@@ -15,41 +15,19 @@
 //! fails, naming the packages, when they are missing.
 #![cfg(target_os = "linux")]
 
+mod clib;
+
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::OnceLock;
 
+use clib::{library, root};
+
 use mpca_tests::scenes::{Scene, build, paper_scenes};
 
 /// What to install when the headers are missing (Debian, Ubuntu).
 const INSTALL: &str = "apt-get install -y libosmesa6-dev libpng-dev";
-
-fn root() -> &'static Path {
-    Path::new(env!("CARGO_MANIFEST_DIR")).parent().expect("tests/ lies in the workspace")
-}
-
-/// The directory holding `libmpca.a`: the same nested cargo build, into the
-/// same target directory and with the same features, as tests/c_abi.rs, so
-/// the two test programs share one build of the library instead of paying
-/// for two (mpca_debug_panic, which `panic-test` adds, goes unused here).
-fn library() -> &'static Path {
-    static DIR: OnceLock<PathBuf> = OnceLock::new();
-    DIR.get_or_init(|| {
-        let target_dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("ffi");
-        let cargo = std::env::var_os("CARGO").unwrap_or_else(|| env!("CARGO").into());
-        let out = Command::new(cargo)
-            .current_dir(root())
-            .args(["build", "--release", "-p", "mpca-ffi", "--features", "panic-test", "--target-dir"])
-            .arg(&target_dir)
-            .output()
-            .expect("cargo runs");
-        assert!(out.status.success(), "building libmpca failed:\n{}", String::from_utf8_lossy(&out.stderr));
-        let dir = target_dir.join("release");
-        assert!(dir.join("libmpca.a").is_file(), "libmpca.a missing from {}", dir.display());
-        dir
-    })
-}
 
 /// The C compiler cc picks for this target.
 fn c_compiler() -> cc::Tool {

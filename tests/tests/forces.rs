@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{mean_and_se, memory, scale, TestRng, Z};
+use common::{mean_and_se, memory, scale, Z};
 use mpca::{Boundary, Description, Quantization, Vortex, World};
 
 /// The cells of one coordinate axis used as probes: 4i and 4i + 3. At
@@ -95,7 +95,7 @@ fn forces_give_the_specified_velocity_change() {
         desc.seed = 91;
         let mut mem = memory(&desc);
         let world = World::init(&desc, &mut mem).unwrap();
-        let mut rng = TestRng::new(91);
+        let mut rng = common::test_rng(91);
         let cells = (n * n) as usize;
         let field: Vec<f32> = (0..2 * cells).map(|_| 0.02 * (rng.unit() - 0.5)).collect();
         let potential: Vec<f32> = (0..cells)

@@ -182,7 +182,7 @@ fn variants(make: impl Fn(u32) -> Description) -> Vec<(String, Description)> {
 }
 
 fn fill_half(world: &mut World, masses: &[f32]) -> u64 {
-    let mut rng = TestRng::new(world.description().seed);
+    let mut rng = common::test_rng(world.description().seed);
     scatter(world, 0.5, 1.0, masses, &mut rng)
 }
 
@@ -222,7 +222,7 @@ fn huge_forces_keep_speeds_bounded() {
             Box::new(|w| {
                 let dim = w.description().dim as usize;
                 let n = w.description().size[..dim].iter().product::<u32>() as usize;
-                let mut rng = TestRng::new(9);
+                let mut rng = common::test_rng(9);
                 let f: Vec<f32> = (0..n * dim).map(|_| 2e6 * (rng.unit() - 0.5)).collect();
                 w.set_force_field(&f).unwrap();
             }),
@@ -421,7 +421,7 @@ fn pairs(dim: u32, q: Quantization, masses: [f32; 2], e: f32, seed: u64) -> (Vec
     desc.mass_classes = 2;
     let mut mem = memory(&desc);
     let world = World::init(&desc, &mut mem).unwrap();
-    let mut rng = TestRng::new(seed);
+    let mut rng = common::test_rng(seed);
     let cells_per_block = 1u32 << dim;
     let blocks = if dim == 2 { (n / 2) * (n / 2) } else { (n / 2) * (n / 2) * (n / 2) };
     for b in 0..blocks {
@@ -539,7 +539,7 @@ fn mixed_extreme_masses_stay_finite() {
                 desc.seed = 77;
                 let mut mem = memory(&desc);
                 let world = World::init(&desc, &mut mem).unwrap();
-                let mut rng = TestRng::new(77);
+                let mut rng = common::test_rng(77);
                 let n = scatter(world, 0.4, 1.0, masses, &mut rng);
                 for t in 0..200 {
                     world.step(1);
@@ -574,7 +574,7 @@ fn set_fields(w: &mut World, scale_forces: f32) {
     let desc = *w.description();
     let dim = desc.dim as usize;
     let n = cells(&desc).count();
-    let mut rng = TestRng::new(4);
+    let mut rng = common::test_rng(4);
     let f: Vec<f32> = (0..n * dim).map(|_| 0.04 * scale_forces * (rng.unit() - 0.5)).collect();
     w.set_force_field(&f).unwrap();
     let u: Vec<f32> = cells(&desc).map(|p| 0.01 * scale_forces * (p[0] as f32 + 0.5 * p[1] as f32)).collect();
@@ -646,7 +646,7 @@ fn zero_time_step_ignores_even_infinite_forces() {
             world.set_potential(&u).unwrap();
             let f: Vec<f32> = cells(&desc).flat_map(|_| [1e30f32, -1e30, 1e30].into_iter().take(dim as usize)).collect();
             world.set_force_field(&f).unwrap();
-            let mut rng = TestRng::new(19);
+            let mut rng = common::test_rng(19);
             let mut before = std::collections::BTreeMap::new();
             for pos in cells(&desc).filter(|p| p.iter().take(dim as usize).all(|&c| c % 4 == 1)) {
                 let m = if (pos[0] / 4) % 2 == 0 { 1.0 } else { 1e-30 };
@@ -855,24 +855,7 @@ fn make_busy(w: &mut World) {
 /// description as before.
 #[test]
 fn non_finite_inputs_are_refused_and_change_nothing() {
-    type Setter = fn(&mut Description, f32);
-    let fields: [(&str, Setter); 12] = [
-        ("mass", |d, v| d.mass = v),
-        ("restitution", |d, v| d.restitution = v),
-        ("wall_restitution", |d, v| d.wall_restitution = v),
-        ("dt", |d, v| d.dt = v),
-        ("gravity x", |d, v| d.gravity[0] = v),
-        ("gravity y", |d, v| d.gravity[1] = v),
-        ("gravity z", |d, v| d.gravity[2] = v),
-        ("vortex centre x", |d, v| d.vortex.centre[0] = v),
-        ("vortex centre y", |d, v| d.vortex.centre[1] = v),
-        ("vortex core", |d, v| d.vortex.core_radius = v),
-        ("vortex circulation", |d, v| d.vortex.circulation = v),
-        ("vortex circulation, vortex on", |d, v| {
-            d.forces.vortex = true;
-            d.vortex.circulation = v;
-        }),
-    ];
+        let fields = common::description_floats();
     for dim in [2u32, 3] {
         for bad in NON_FINITE {
             for (name, set) in fields {
@@ -986,7 +969,7 @@ fn full_world_stays_full() {
             desc.seed = 13;
             let mut mem = memory(&desc);
             let world = World::init(&desc, &mut mem).unwrap();
-            let mut rng = TestRng::new(13);
+            let mut rng = common::test_rng(13);
             for pos in cells(&desc) {
                 world.add_particle(pos, rng.velocity(dim, 0.3)).unwrap();
             }
@@ -1080,7 +1063,7 @@ fn one_cell_corridors() {
                 let in_corridor = |p: [u32; 3]| p[1] == 4 && (dim == 2 || p[2] == 4);
                 let mask: Vec<u8> = cells(&desc).map(|p| u8::from(!in_corridor(p))).collect();
                 world.add_obstacle_mask(&mask, e).unwrap();
-                let mut rng = TestRng::new(14);
+                let mut rng = common::test_rng(14);
                 let mut n = 0;
                 for x in (0..32).step_by(2) {
                     world.add_particle([x, 4, if dim == 3 { 4 } else { 0 }], rng.velocity(dim, 1.0)).unwrap();
@@ -1121,7 +1104,7 @@ fn sealed_particles_stay_in_their_pocket() {
             let in_pocket = |p: [u32; 3]| (5..7).contains(&p[0]) && (5..7).contains(&p[1]) && (dim == 2 || (5..7).contains(&p[2]));
             let mask: Vec<u8> = cells(&desc).map(|p| u8::from(p != single && !in_pocket(p))).collect();
             world.add_obstacle_mask(&mask, 1.0).unwrap();
-            let mut rng = TestRng::new(15);
+            let mut rng = common::test_rng(15);
             world.add_particle(single, rng.velocity(dim, 1.0)).unwrap();
             let pocket: Vec<[u32; 3]> = cells(&desc).filter(|&p| in_pocket(p)).collect();
             let k = if dim == 2 { 3 } else { 5 };
@@ -1163,7 +1146,7 @@ fn packed_gas_never_enters_obstacles() {
             desc.seed = 18;
             let mut mem = memory(&desc);
             let world = World::init(&desc, &mut mem).unwrap();
-            let mut rng = TestRng::new(18);
+            let mut rng = common::test_rng(18);
             let n = desc.size[0];
             let boxes = if dim == 2 { 40 } else { 30 };
             for _ in 0..boxes {
@@ -1212,7 +1195,7 @@ fn smallest_worlds_with_every_boundary() {
             let what = format!("{dim}D {:?}", &desc.boundary[..dim as usize]);
             let mut mem = memory(&desc);
             let world = World::init(&desc, &mut mem).unwrap();
-            let mut rng = TestRng::new(c as u64);
+            let mut rng = common::test_rng(c as u64);
             for pos in cells(&desc) {
                 world.add_particle(pos, rng.velocity(dim, 1.0)).unwrap();
             }
@@ -1367,7 +1350,7 @@ fn long_run(q: Quantization, steps: u64) {
     desc.seed = 1_000_000;
     let mut mem = memory(&desc);
     let world = World::init(&desc, &mut mem).unwrap();
-    let mut rng = TestRng::new(16);
+    let mut rng = common::test_rng(16);
     let mut n = 0;
     while n < 20 {
         if world.add_particle([rng.below(8), rng.below(8), 0], rng.velocity(2, 1.0)).is_ok() {

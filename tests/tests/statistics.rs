@@ -10,7 +10,7 @@
 
 mod common;
 
-use common::{assert_binomial, mean_and_se, memory, particle, TestRng, Z};
+use common::{assert_binomial, mean_and_se, memory, particle, Z};
 use mpca::{Boundary, Description, Drift, Emitter, World};
 
 // ------------------------------------------------------------ M5.2 collisions
@@ -30,7 +30,7 @@ fn collisions_with_k(dim: u32, n: u32, k: usize, seed: u64) -> (u64, u64) {
     let world = World::init(&desc, &mut mem).unwrap();
     let cells = 1usize << dim;
     let nz = if dim == 3 { n } else { 1 };
-    let mut rng = TestRng::new(seed.wrapping_mul(31).wrapping_add(k as u64));
+    let mut rng = common::test_rng(seed.wrapping_mul(31).wrapping_add(k as u64));
     let mut blocks = 0u64;
     for bz in (0..nz).step_by(2) {
         for by in (0..n).step_by(2) {

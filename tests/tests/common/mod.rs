@@ -4,8 +4,6 @@
 #![allow(dead_code)]
 
 use mpca::{Cell, Description, Particle, Quantization, World};
-use rand_core::Rng;
-use rand_pcg::Pcg32;
 
 /// Half-width of every statistical band, in standard deviations. A correct
 /// implementation fails one such check with probability about 6e-7.
@@ -42,45 +40,17 @@ pub fn particle(world: &World, pos: [u32; 3]) -> Particle {
     }
 }
 
-/// The setup stream of the tests: separate from every stream of the world.
-pub struct TestRng(Pcg32);
+/// The cells of a world, shared with the report.
+#[allow(unused_imports)]
+pub use mpca_tests::setup::cells;
 
-impl TestRng {
-    pub fn new(seed: u64) -> Self {
-        TestRng(Pcg32::new(seed ^ 0x07e5_75e7_u64, 0x51))
-    }
+/// The tests' setup stream: the report's generator with the tests' own
+/// stream constants, which the tests' fixed seeds were chosen with.
+pub type TestRng = mpca_tests::setup::SetupRng;
 
-    /// Uniform in [0, 1) with 24 random bits.
-    pub fn unit(&mut self) -> f32 {
-        (self.0.next_u32() >> 8) as f32 * (1.0 / 16_777_216.0)
-    }
-
-    /// Uniform in 0..n (the bias of the multiply-shift, below 2^-32 n, is
-    /// irrelevant for test setup).
-    pub fn below(&mut self, n: u32) -> u32 {
-        ((u64::from(self.0.next_u32()) * u64::from(n)) >> 32) as u32
-    }
-
-    /// A velocity uniform in the disc (2D) or ball (3D) of radius `r`, by
-    /// rejection from the cube.
-    pub fn velocity(&mut self, dim: u32, r: f32) -> [f32; 3] {
-        loop {
-            let mut v = [0.0f32; 3];
-            for c in v.iter_mut().take(dim as usize) {
-                *c = r * (2.0 * self.unit() - 1.0);
-            }
-            if v.iter().map(|c| c * c).sum::<f32>() <= r * r {
-                return v;
-            }
-        }
-    }
-}
-
-/// Cells of a world, `x` fastest, as positions (`z = 0` in 2D).
-pub fn cells(desc: &Description) -> impl Iterator<Item = [u32; 3]> {
-    let nz = if desc.dim == 3 { desc.size[2] } else { 1 };
-    let [nx, ny, _] = desc.size;
-    (0..nz).flat_map(move |z| (0..ny).flat_map(move |y| (0..nx).map(move |x| [x, y, z])))
+/// The tests' setup stream for `seed`.
+pub fn test_rng(seed: u64) -> TestRng {
+    TestRng::with_stream(seed ^ 0x07e5_75e7_u64, 0x51)
 }
 
 /// Mean and standard error of the mean of `xs` (sample variance, n - 1).
@@ -102,4 +72,29 @@ pub fn assert_binomial(observed: u64, n: u64, p: f64, what: &str) {
         "{what}: observed {observed}, expected {mean:.1} +- {:.1} (5 sd, n = {n}, p = {p})",
         Z * sd
     );
+}
+
+/// A setter of one float of a description.
+pub type Setter = fn(&mut Description, f32);
+
+/// Every float a description holds, by name, the circulation also with the
+/// vortex switched on (M1: each must be finite).
+pub fn description_floats() -> [(&'static str, Setter); 12] {
+    [
+        ("mass", |d, v| d.mass = v),
+        ("restitution", |d, v| d.restitution = v),
+        ("wall_restitution", |d, v| d.wall_restitution = v),
+        ("dt", |d, v| d.dt = v),
+        ("gravity x", |d, v| d.gravity[0] = v),
+        ("gravity y", |d, v| d.gravity[1] = v),
+        ("gravity z", |d, v| d.gravity[2] = v),
+        ("vortex centre x", |d, v| d.vortex.centre[0] = v),
+        ("vortex centre y", |d, v| d.vortex.centre[1] = v),
+        ("vortex core radius", |d, v| d.vortex.core_radius = v),
+        ("vortex circulation", |d, v| d.vortex.circulation = v),
+        ("vortex circulation, vortex on", |d, v| {
+            d.forces.vortex = true;
+            d.vortex.circulation = v;
+        }),
+    ]
 }

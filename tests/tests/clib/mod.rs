@@ -1,0 +1,42 @@
+//! What the C test programs share: the workspace root and libmpca, built
+//! once per test process by a nested cargo (c_abi.rs and examples.rs use
+//! the same target directory and features, so one build serves both).
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::sync::OnceLock;
+
+/// The workspace root.
+pub fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR")).parent().expect("tests/ lies in the workspace")
+}
+
+/// The directory holding `libmpca.a` and `libmpca.so`, built once per test
+/// process with the `panic-test` feature (for `mpca_debug_panic`).
+///
+/// A nested cargo, because the C programs need the real libraries: mpca-ffi
+/// is a staticlib and a cdylib with no rlib, so this crate cannot depend on
+/// it and the outer build never produces them for the tests. Its own target
+/// directory keeps it off the build directory lock that the outer `cargo
+/// test` holds while the tests run.
+pub fn library() -> &'static Path {
+    static DIR: OnceLock<PathBuf> = OnceLock::new();
+    DIR.get_or_init(|| {
+        let target_dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("ffi");
+        let cargo = std::env::var_os("CARGO").unwrap_or_else(|| env!("CARGO").into());
+        let out = Command::new(cargo)
+            .current_dir(root())
+            .args(["build", "--release", "-p", "mpca-ffi", "--features", "panic-test", "--target-dir"])
+            .arg(&target_dir)
+            .output()
+            .expect("cargo runs");
+        assert!(out.status.success(), "building libmpca failed:\n{}", String::from_utf8_lossy(&out.stderr));
+        let dir = target_dir.join("release");
+        for lib in ["libmpca.a", "libmpca.so"] {
+            assert!(dir.join(lib).is_file(), "{lib} missing from {}", dir.display());
+        }
+        dir
+    })
+}
+
