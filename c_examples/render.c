@@ -155,6 +155,17 @@ void view2d_begin(uint32_t nx, uint32_t ny) {
     glDisable(GL_DEPTH_TEST);
 }
 
+/* Draws the first n points of the scratch arrays (positions and colours). */
+static void draw_scratch_points(size_t n) {
+    glEnableClientState(GL_VERTEX_ARRAY);
+    glEnableClientState(GL_COLOR_ARRAY);
+    glVertexPointer(3, GL_FLOAT, 0, scratch.pos);
+    glColorPointer(3, GL_UNSIGNED_BYTE, 0, scratch.rgb);
+    glDrawArrays(GL_POINTS, 0, (GLsizei)n);
+    glDisableClientState(GL_COLOR_ARRAY);
+    glDisableClientState(GL_VERTEX_ARRAY);
+}
+
 size_t draw_particles_2d(mpca_world *w, const view *v) {
     size_t n = export_particles(w);
     for (size_t i = 0; i < n; i++) {
@@ -165,13 +176,7 @@ size_t draw_particles_2d(mpca_world *w, const view *v) {
      * inside its own cell, and no two particles share a cell (M1). */
     glDisable(GL_POINT_SMOOTH);
     glPointSize((float)v->point_px);
-    glEnableClientState(GL_VERTEX_ARRAY);
-    glEnableClientState(GL_COLOR_ARRAY);
-    glVertexPointer(3, GL_FLOAT, 0, scratch.pos);
-    glColorPointer(3, GL_UNSIGNED_BYTE, 0, scratch.rgb);
-    glDrawArrays(GL_POINTS, 0, (GLsizei)n);
-    glDisableClientState(GL_COLOR_ARRAY);
-    glDisableClientState(GL_VERTEX_ARRAY);
+    draw_scratch_points(n);
     return n;
 }
 
@@ -398,13 +403,7 @@ drawn draw_particles_3d(mpca_world *w, const view *v, const camera *c, const uin
     glTexEnvi(GL_TEXTURE_ENV, GL_TEXTURE_ENV_MODE, GL_MODULATE);
     glEnable(GL_ALPHA_TEST);
     glAlphaFunc(GL_GREATER, 0.5f);
-    glEnableClientState(GL_VERTEX_ARRAY);
-    glEnableClientState(GL_COLOR_ARRAY);
-    glVertexPointer(3, GL_FLOAT, 0, scratch.pos);
-    glColorPointer(3, GL_UNSIGNED_BYTE, 0, scratch.rgb);
-    glDrawArrays(GL_POINTS, 0, (GLsizei)n);
-    glDisableClientState(GL_COLOR_ARRAY);
-    glDisableClientState(GL_VERTEX_ARRAY);
+    draw_scratch_points(n);
     glDisable(GL_ALPHA_TEST);
     glDisable(GL_TEXTURE_2D);
     glDisable(GL_POINT_SPRITE);

@@ -177,6 +177,20 @@ static void check_accounting(const mpca_stats *s, uint64_t added, uint64_t steps
     CHECK(s->bytes_per_cell > 0);
 }
 
+/* Prints the world's hash and statistics as "hash<name>: ..." and
+ * "stats<name>: ..." lines for the Rust side, filling in the statistics. */
+static void report_world(const mpca_world *w, const char *name, mpca_stats *s) {
+    uint64_t hash = 0;
+    char label[16];
+    memset(s, 0, sizeof *s);
+    s->struct_size = sizeof *s;
+    CHECK_OK(mpca_world_hash(w, &hash));
+    CHECK_OK(mpca_world_stats(w, s));
+    printf("hash%s: %016" PRIx64 "\n", name, hash);
+    snprintf(label, sizeof label, "stats%s", name);
+    print_stats(label, s);
+}
+
 static void scene_2d(void) {
     check_context = "2D scene";
     mpca_desc d;
@@ -228,14 +242,8 @@ static void scene_2d(void) {
     }
     CHECK_OK(mpca_world_step(w, S2_STEPS));
 
-    uint64_t hash = 0;
     mpca_stats s;
-    memset(&s, 0, sizeof s);
-    s.struct_size = sizeof s;
-    CHECK_OK(mpca_world_hash(w, &hash));
-    CHECK_OK(mpca_world_stats(w, &s));
-    printf("hash2d: %016" PRIx64 "\n", hash);
-    print_stats("stats2d", &s);
+    report_world(w, "2d", &s);
     check_accounting(&s, S2_PARTICLES, S2_STEPS);
     /* Each path of the accounting was taken. */
     CHECK(s.emitted > 0 && s.exited > 0 && s.expired > 0);
@@ -290,14 +298,8 @@ static void scene_3d(void) {
     }
     CHECK_OK(mpca_world_step(w, S3_STEPS));
 
-    uint64_t hash = 0;
     mpca_stats s;
-    memset(&s, 0, sizeof s);
-    s.struct_size = sizeof s;
-    CHECK_OK(mpca_world_hash(w, &hash));
-    CHECK_OK(mpca_world_stats(w, &s));
-    printf("hash3d: %016" PRIx64 "\n", hash);
-    print_stats("stats3d", &s);
+    report_world(w, "3d", &s);
     check_accounting(&s, added, S3_STEPS);
     CHECK(s.particles == added); /* walls all round, no emitter, no lifetimes */
     CHECK(s.collisions > 0);
