@@ -161,12 +161,7 @@ impl Val {
                 Fmt::Sig | Fmt::Text => sig(*v),
             },
             Val::Time { timing, per, unit } => {
-                let f = match *unit {
-                    "s" => 1.0,
-                    "ms" => 1e3,
-                    "us" => 1e6,
-                    _ => 1e9,
-                } / per;
+                let f = unit_factor(unit, *per);
                 format!("{} ({}–{})", sig(timing.median() * f), sig(timing.min() * f), sig(timing.max() * f))
             }
         }
@@ -179,12 +174,7 @@ impl Val {
             Val::Count(n) => Json::from(*n),
             Val::Num(v) => Json::Num(*v),
             Val::Time { timing, per, unit } => {
-                let f = match *unit {
-                    "s" => 1.0,
-                    "ms" => 1e3,
-                    "us" => 1e6,
-                    _ => 1e9,
-                } / per;
+                let f = unit_factor(unit, *per);
                 crate::json::obj([
                     ("unit", (*unit).into()),
                     ("median", (timing.median() * f).into()),
@@ -245,6 +235,18 @@ impl Table {
             .collect();
         crate::json::obj([("title", self.title.clone().into()), ("about", self.about.clone().into()), ("rows", Json::Arr(rows))])
     }
+}
+
+
+/// Seconds-to-`unit` factor for one of `per` items (`s`, `ms`, `us`, else ns).
+fn unit_factor(unit: &str, per: f64) -> f64 {
+    let scale = match unit {
+        "s" => 1.0,
+        "ms" => 1e3,
+        "us" => 1e6,
+        _ => 1e9,
+    };
+    scale / per
 }
 
 #[cfg(test)]
