@@ -452,14 +452,13 @@ impl World {
     /// Makes one cell an obstacle with the given outward normal (normalised
     /// here) and restitution.
     pub fn add_obstacle(&mut self, pos: [u32; 3], normal: [f32; 3], e: f32) -> Result<(), Error> {
-        let s = self.locate(pos)?;
+        self.locate(pos)?;
         finite(&normal)?;
         let mut nrm = normal;
         if self.dim() == 2 {
             nrm[2] = 0.0;
         }
         normalise(nrm).ok_or(Error::UndefinedNormal)?;
-        let _ = s;
         let c = pos.map(|v| v as usize);
         self.add_obstacles(c, c.map(|v| v + 1), e, &|q| q == c, &|_, _, _| nrm, false)
     }
