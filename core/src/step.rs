@@ -338,6 +338,10 @@ impl World {
 
     /// Advances one step, visiting blocks in `order`. The result is the
     /// same bit for bit either way (M8).
+    ///
+    /// Never inlined: `scripts/instructions.sh` counts the instructions
+    /// spent inside it.
+    #[inline(never)]
     pub fn step_in_order(&mut self, order: Order) {
         self.emit();
         let reverse = order == Order::Reverse;

@@ -5,7 +5,9 @@
 //! with the spread, nanoseconds per processed block, the share of blocks
 //! skipped as empty, bytes per cell and the paper's time. Timing is of the
 //! steps alone, not of building the world. `MPCA_BENCH_SCENE=water` (say)
-//! runs one scene only, e.g. under `valgrind --tool=callgrind`.
+//! runs one scene only, e.g. under `valgrind --tool=callgrind`; the last
+//! column, the blocks processed over the run, is what
+//! `scripts/instructions.sh` divides the step's instructions by.
 
 use std::time::Instant;
 
@@ -15,8 +17,8 @@ fn main() {
     let runs: usize = std::env::var("MPCA_BENCH_RUNS").ok().and_then(|s| s.parse().ok()).unwrap_or(5).max(1);
     println!("mpca {} — paper scenes, median of {runs} runs", env!("CARGO_PKG_VERSION"));
     println!(
-        "{:<12} {:>4} {:>9} {:>9} {:>6} {:>11} {:>15} {:>10} {:>9} {:>7} {:>12}",
-        "scene", "sec", "cells", "particles", "steps", "median_ms", "min..max_ms", "ns/block", "skipped", "B/cell", "paper_s"
+        "{:<12} {:>4} {:>9} {:>9} {:>6} {:>11} {:>15} {:>10} {:>9} {:>7} {:>12} {:>10}",
+        "scene", "sec", "cells", "particles", "steps", "median_ms", "min..max_ms", "ns/block", "skipped", "B/cell", "paper_s", "blocks"
     );
     let only = std::env::var("MPCA_BENCH_SCENE").ok();
     let mut memory = Vec::new();
@@ -44,7 +46,7 @@ fn main() {
         let median = times[runs / 2];
         let cells: u64 = scene.desc.size[..scene.desc.dim as usize].iter().map(|&s| u64::from(s)).product();
         println!(
-            "{:<12} {:>4} {:>9} {:>9} {:>6} {:>11.2} {:>7.2}..{:<7.2} {:>10.1} {:>8.1}% {:>7.3} {:>12.0}",
+            "{:<12} {:>4} {:>9} {:>9} {:>6} {:>11.2} {:>7.2}..{:<7.2} {:>10.1} {:>8.1}% {:>7.3} {:>12.0} {:>10}",
             scene.name,
             scene.section,
             cells,
@@ -57,6 +59,7 @@ fn main() {
             100.0 * (total - processed) as f64 / total.max(1) as f64,
             bytes_per_cell,
             scene.paper_seconds,
+            processed,
         );
     }
 }

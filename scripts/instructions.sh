@@ -1,0 +1,33 @@
+#!/usr/bin/env bash
+# Instructions per processed block of the paper's scenes, counted by
+# valgrind's callgrind inside World::step_in_order only (building the world
+# and the benchmark's own loop are not counted). Instruction counts do not
+# depend on the machine's load, unlike times, so they are the figure to
+# compare between commits.
+#
+#   scripts/instructions.sh                 every scene
+#   scripts/instructions.sh aggregation     one scene (aggregation, cluster, smoke, water)
+#
+# Installs valgrind with apt-get when it is missing.
+set -euo pipefail
+cd "$(dirname "${BASH_SOURCE[0]}")/.."
+command -v valgrind >/dev/null || scripts/install-missing.sh valgrind
+
+bench=$(cargo bench -p mpca-tests --bench scenes --no-run --message-format=json 2>/dev/null |
+    grep '"kind":\["bench"\]' | sed -n 's/.*"executable":"\([^"]*\)".*/\1/p' | tail -1)
+[ -x "$bench" ] || { echo "instructions: the benchmark did not build" >&2; exit 1; }
+
+scenes=("$@")
+[ ${#scenes[@]} -gt 0 ] || scenes=(aggregation cluster smoke water)
+out=$(mktemp -d)
+trap 'rm -rf "$out"' EXIT
+printf '%-12s %14s %12s %16s\n' scene instructions blocks "instr/block"
+for scene in "${scenes[@]}"; do
+    line=$(MPCA_BENCH_SCENE=$scene MPCA_BENCH_RUNS=1 valgrind --tool=callgrind \
+        --callgrind-out-file="$out/$scene.cg" --collect-atstart=no \
+        --toggle-collect='*World*step_in_order*' "$bench" 2>/dev/null | awk -v s="$scene" '$1 == s')
+    [ -n "$line" ] || { echo "instructions: no benchmark line for '$scene'" >&2; exit 1; }
+    blocks=$(echo "$line" | awk '{print $NF}')
+    instr=$(awk '/^(summary|totals):/{print $2; exit}' "$out/$scene.cg")
+    awk -v s="$scene" -v i="$instr" -v b="$blocks" 'BEGIN { printf "%-12s %14.0f %12.0f %16.1f\n", s, i, b, i / b }'
+done
