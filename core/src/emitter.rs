@@ -6,9 +6,10 @@
 //! counted as shortfall. Draws come from the emitter's own stream
 //! `(seed, step, emitter index)` (M8).
 
-use crate::collision::{clamp, dot, random_unit};
+use crate::collision::random_unit;
 use crate::desc::finite;
-use crate::rng::{below, chance, emitter_stream, unit};
+use crate::rng::{StepKey, Stream};
+use crate::vector::{clamp, dot};
 use crate::world::{Plain, World};
 use crate::Error;
 
@@ -96,13 +97,14 @@ impl World {
     /// Runs every emitter once (M6), at the start of a step.
     pub(crate) fn emit(&mut self) {
         let (seed, step, dim) = (self.head.desc.seed, self.head.step, self.dim());
+        let key = StepKey::emitters(seed, step);
         for i in 0..self.head.emitters as usize {
             let slot: Slot = self.plane::<Slot>(self.layout().emitters)[i];
             let e = slot.emitter;
-            let mut rng = emitter_stream(seed, step, i as u64);
+            let mut rng = key.stream(i as u64);
             let whole = libm::floorf(e.rate);
             // Casting saturates, so an absurd rate asks for u64::MAX.
-            let wanted = (whole as u64).saturating_add(u64::from(chance(&mut rng, e.rate - whole)));
+            let wanted = (whole as u64).saturating_add(u64::from(rng.chance(e.rate - whole)));
             if wanted == 0 {
                 continue;
             }
@@ -120,7 +122,7 @@ impl World {
                 // Selection sampling: take this cell with chance need/left,
                 // which picks a uniform subset of `placing` free cells.
                 // `left` counts cells, so it fits the u32 of `below`.
-                let take = u64::from(below(&mut rng, left as u32)) < need;
+                let take = u64::from(rng.below(left as u32)) < need;
                 left -= 1;
                 if take {
                     need -= 1;
@@ -148,13 +150,13 @@ fn each_site(l: &crate::desc::Layout, e: &Emitter, mut f: impl FnMut(crate::worl
 
 /// The emitter's velocity plus a uniform point of the disc or ball of radius
 /// `spread`.
-fn spread_velocity(e: &Emitter, dim: usize, rng: &mut crate::rng::Stream) -> [f32; 3] {
+fn spread_velocity(e: &Emitter, dim: usize, rng: &mut Stream) -> [f32; 3] {
     let mut v = e.velocity;
     if e.spread > 0.0 {
         let (dir, radius) = if dim == 2 {
-            (random_unit::<2, _>(rng), libm::sqrtf(unit(rng)))
+            (random_unit::<2>(rng), libm::sqrtf(rng.unit()))
         } else {
-            (random_unit::<3, _>(rng), libm::cbrtf(unit(rng)))
+            (random_unit::<3>(rng), libm::cbrtf(rng.unit()))
         };
         for k in 0..3 {
             v[k] += e.spread * radius * dir[k];
@@ -162,6 +164,6 @@ fn spread_velocity(e: &Emitter, dim: usize, rng: &mut crate::rng::Stream) -> [f3
     }
     // |velocity| + spread <= 1 was checked; rounding may still leave a hair
     // over 1, which is no clamp of the model's, so it is not counted.
-    let _ = clamp(&mut v, e.mass);
+    let _ = clamp(&mut v, 1.0);
     v
 }

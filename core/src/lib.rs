@@ -43,6 +43,7 @@ mod desc;
 mod emitter;
 mod error;
 mod force;
+mod kernel;
 mod obstacle;
 #[cfg(feature = "alloc")]
 mod owned;
@@ -50,6 +51,7 @@ mod partition;
 mod quant;
 pub mod rng;
 mod step;
+mod vector;
 mod world;
 
 pub use assign::Method;

@@ -9,8 +9,9 @@
 //! undefined is refused, and so is anything that does not fit: adding an
 //! obstacle either succeeds whole or changes nothing.
 
-use crate::collision::dot;
-use crate::desc::{finite, restitution, Boundary};
+use crate::desc::{finite, restitution};
+use crate::partition::{resolve, Beyond};
+use crate::vector::{dot, normalise};
 use crate::world::{put_bit, Plain, World};
 use crate::Error;
 
@@ -69,12 +70,6 @@ pub enum Shape {
     },
 }
 
-/// `v / |v|`, or `None` where the length is zero or not finite.
-pub(crate) fn normalise(v: [f32; 3]) -> Option<[f32; 3]> {
-    let len = libm::sqrtf(dot(v, v));
-    (len.is_finite() && len > 1e-6).then(|| [v[0] / len, v[1] / len, v[2] / len])
-}
-
 /// Eq. 9: `v' = v - (1 + e)(N.v)N`, for a particle moving into the surface
 /// (`N.v < 0`; the step makes sure of that by choosing `N`). A particle
 /// moving away along `N` is returned unchanged, never turned back into the
@@ -101,13 +96,6 @@ type Mask<'a> = &'a dyn Fn([usize; 3]) -> bool;
 /// Gives a surface cell's outward normal, unnormalised, given the set of
 /// cells that will be obstacles.
 type NormalFn<'a> = &'a dyn Fn(&World, [usize; 3], Mask<'_>) -> [f32; 3];
-
-/// What lies at a neighbour of a cell.
-enum Beyond {
-    Inside([usize; 3]),
-    Wall,
-    Open,
-}
 
 impl Shape {
     fn check(&self, dim: usize) -> Result<(), Error> {
@@ -226,32 +214,8 @@ fn centre(c: [usize; 3]) -> [f32; 3] {
 impl World {
     /// The neighbour of `c` at offset `off`, after the boundary rules (M4).
     fn beyond(&self, c: [usize; 3], off: [i32; 3]) -> Beyond {
-        let l = self.layout();
-        let mut out = [0usize; 3];
-        let mut wall = false;
-        let mut open = false;
-        for k in 0..3 {
-            let v = c[k] as i64 + i64::from(off[k]);
-            let n = l.n[k] as i64;
-            if (0..n).contains(&v) {
-                out[k] = v as usize;
-                continue;
-            }
-            let face = self.head.desc.boundary[k][usize::from(v >= n)];
-            match face {
-                Boundary::Periodic => out[k] = v.rem_euclid(n) as usize,
-                Boundary::Wall => wall = true,
-                Boundary::Open => open = true,
-            }
-        }
-        // A cell beyond a wall and an open face at once is wall (M4 corner).
-        if wall {
-            Beyond::Wall
-        } else if open {
-            Beyond::Open
-        } else {
-            Beyond::Inside(out)
-        }
+        let at = [0, 1, 2].map(|k| c[k] as i64 + i64::from(off[k]));
+        resolve(self.layout().n, &self.head.desc.boundary, at)
     }
 
     /// Whether the neighbour of `c` at `off` is free once the cells for which
@@ -260,7 +224,7 @@ impl World {
     fn free_after(&self, c: [usize; 3], off: [i32; 3], obstacle: Mask<'_>) -> bool {
         match self.beyond(c, off) {
             Beyond::Inside(nb) => !obstacle(nb),
-            Beyond::Wall => false,
+            Beyond::Wall(_) => false,
             Beyond::Open => true,
         }
     }

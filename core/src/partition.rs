@@ -17,6 +17,52 @@
 //! only the set bits of the fold are visited.
 
 use crate::desc::{Boundary, Layout};
+use crate::vector::normalise;
+
+/// Where a cell coordinate lands under the boundary rules of M4.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Beyond {
+    /// A cell of the domain, wrapped across periodic faces.
+    Inside([usize; 3]),
+    /// Beyond a wall: an obstacle with this unit inward normal (the
+    /// normalised sum of the walls' normals where walls meet). A cell beyond
+    /// both a wall and an open face is wall.
+    Wall([f32; 3]),
+    /// Beyond open faces only: a particle sent there leaves.
+    Open,
+}
+
+/// M4: what lies at the (possibly out-of-domain) cell coordinates `c` of a
+/// domain of `n` cells per axis with faces `boundary`. Axes beyond the
+/// world's dimension have `n = 1` and `c = 0`.
+pub(crate) fn resolve(n: [usize; 3], boundary: &[[Boundary; 2]; 3], c: [i64; 3]) -> Beyond {
+    let mut out = [0usize; 3];
+    let mut wall = [0.0f32; 3];
+    let (mut is_wall, mut is_open) = (false, false);
+    for k in 0..3 {
+        let nk = n[k] as i64;
+        if (0..nk).contains(&c[k]) {
+            out[k] = c[k] as usize;
+            continue;
+        }
+        let high = c[k] >= nk;
+        match boundary[k][usize::from(high)] {
+            Boundary::Periodic => out[k] = c[k].rem_euclid(nk) as usize,
+            Boundary::Wall => {
+                is_wall = true;
+                wall[k] = if high { -1.0 } else { 1.0 };
+            }
+            Boundary::Open => is_open = true,
+        }
+    }
+    if is_wall {
+        Beyond::Wall(normalise(wall).unwrap_or([0.0; 3]))
+    } else if is_open {
+        Beyond::Open
+    } else {
+        Beyond::Inside(out)
+    }
+}
 
 /// One axis of a step's partition.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -36,12 +82,48 @@ pub(crate) struct Partition {
     row_words: usize,
 }
 
+/// One row of blocks of a step's partition: the blocks that share their y
+/// (and z) cells. Block row `r` of a block (its cells `2r` and `2r + 1`,
+/// `r = dy + 2 dz`) lies in the domain row whose first bit-plane word is
+/// `word[r]` and whose first cell is `cell[r]`.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct BlockRow {
+    pub word: [usize; 4],
+    pub cell: [usize; 4],
+    /// The block cells beyond a y or z face (a half block on a face that is
+    /// not periodic), as a mask over the block's cells; their `word` and
+    /// `cell` are 0 and mean nothing.
+    pub outside: u8,
+    /// The y and z of the blocks' lowest corner.
+    pub origin: [isize; 2],
+    /// The index (M8) of the row's block 0.
+    pub index: u64,
+}
+
 /// What the sweep hands each occupied block to.
 pub(crate) trait BlockSink {
+    /// Cells of a block: 4 in 2D, 8 in 3D.
+    const CELLS: usize;
     /// The occupancy plane, read between visits.
     fn occupancy(&self) -> &[u64];
-    /// Processes the block with lowest corner `origin` and index `index`.
-    fn visit(&mut self, origin: [isize; 3], index: u64);
+    /// Processes block `bx` of `row`, whose lowest corner has x `x0` and
+    /// whose cells holding a particle are the set bits of `occ` (bit `c` for
+    /// cell `c`, never a cell beyond a face).
+    fn visit(&mut self, row: &BlockRow, x0: isize, bx: usize, occ: u8);
+}
+
+/// The block cells with offset `d` along axis `k`, for blocks of `2^dim`
+/// cells: bit `c` set where `(c >> k) & 1 == d`.
+pub(crate) const fn cells_at(k: usize, d: usize, dim: usize) -> u8 {
+    let mut mask = 0u8;
+    let mut c = 0;
+    while c < 1 << dim {
+        if (c >> k) & 1 == d {
+            mask |= 1 << c;
+        }
+        c += 1;
+    }
+    mask
 }
 
 const EVEN: u64 = 0x5555_5555_5555_5555;
@@ -70,18 +152,32 @@ impl Partition {
         self.axes.iter().map(|a| a.blocks as u64).product()
     }
 
-    /// The in-domain cell coordinate `first + 2 b + d` along axis `k`
-    /// (wrapped if periodic), or `None` outside the domain.
+    /// The coordinates of cell `c` of a block of `row` whose x coordinates
+    /// are `xs`: `[xs[0], y, z]` with y and z of the row's cell `c`.
+    /// Meaningful for cells inside the domain only.
     #[inline]
-    pub fn coord(&self, k: usize, origin: isize, d: usize) -> Option<usize> {
+    pub fn cell_coords(&self, row: &BlockRow, xs: [usize; 3], c: usize) -> [usize; 3] {
+        let y = self.axis_pair(1, row.origin[0]).0[(c >> 1) & 1];
+        let z = self.axis_pair(2, row.origin[1]).0[(c >> 2) & 1];
+        [xs[0], y, z]
+    }
+
+    /// The coordinates of a block's two cells along axis `k`, for the block
+    /// starting at `origin`, and a mask of those beyond a face (bit `d` for
+    /// cell `origin + d`; its coordinate is then 0 and means nothing). Only
+    /// a block at offset 1 on a face that is not periodic has one; on a
+    /// periodic axis the last block wraps round to cell 0.
+    #[inline]
+    pub fn axis_pair(&self, k: usize, origin: isize) -> ([usize; 2], u8) {
         let a = &self.axes[k];
-        let c = origin + d as isize;
-        if c >= 0 && (c as usize) < a.n {
-            Some(c as usize)
+        if origin < 0 {
+            ([0, 0], 0b01)
+        } else if origin as usize + 1 < a.n {
+            ([origin as usize, origin as usize + 1], 0)
         } else if a.periodic {
-            Some(c.rem_euclid(a.n as isize) as usize)
+            ([a.n - 1, 0], 0)
         } else {
-            None
+            ([a.n - 1, 0], 0b10)
         }
     }
 
@@ -90,43 +186,76 @@ impl Partition {
     /// leave the same world; the tests check it.
     pub fn sweep<S: BlockSink>(&self, sink: &mut S, reverse: bool) {
         let [ax, ay, az] = self.axes;
-        let zs = if self.dim == 3 { 2 } else { 1 };
+        let layers = if self.dim == 3 { 2 } else { 1 };
         for i in 0..ay.blocks * az.blocks {
             let i = if reverse { ay.blocks * az.blocks - 1 - i } else { i };
             let (by, bz) = (i % ay.blocks, i / ay.blocks);
-            let (oy, oz) = (ay.first + 2 * by as isize, az.first + 2 * bz as isize);
-            // The rows (y, z) of this row of blocks that lie in the domain.
-            let mut rows = [0usize; 4];
-            let mut nrows = 0;
-            for dz in 0..zs {
+            let origin = [ay.first + 2 * by as isize, az.first + 2 * bz as isize];
+            let (ys, y_out) = self.axis_pair(1, origin[0]);
+            let (zs, z_out) = self.axis_pair(2, origin[1]);
+            let mut row = BlockRow { word: [0; 4], cell: [0; 4], outside: 0, origin, index: (i * ax.blocks) as u64 };
+            for dz in 0..layers {
                 for dy in 0..2 {
-                    if let (Some(y), Some(z)) = (self.coord(1, oy, dy), self.coord(2, oz, dz)) {
-                        rows[nrows] = (y + ay.n * z) * self.row_words;
-                        nrows += 1;
+                    let r = dy + 2 * dz;
+                    if (y_out >> dy | z_out >> dz) & 1 != 0 {
+                        row.outside |= cells_at(1, dy, self.dim) & cells_at(2, dz, self.dim);
+                        continue;
                     }
+                    let line = ys[dy] + ay.n * zs[dz];
+                    row.word[r] = line * self.row_words;
+                    row.cell[r] = line * ax.n;
                 }
             }
-            let rows = &rows[..nrows];
-            let row_index = (i * ax.blocks) as u64;
-            self.sweep_row(sink, rows, [oy, oz], row_index, reverse);
+            self.sweep_row(sink, &row, reverse);
         }
     }
 
-    /// The OR of word `w` over the rows of a row of blocks.
+    /// Word `w` of each domain row of a row of blocks (0 for a row beyond
+    /// a face), block row `r` in element `r`.
     #[inline]
-    fn word(occ: &[u64], rows: &[usize], w: usize) -> u64 {
-        rows.iter().fold(0, |m, &r| m | occ[r + w])
+    fn words<const ROWS: usize>(occ: &[u64], row: &BlockRow, w: usize) -> [u64; ROWS] {
+        let mut m = [0; ROWS];
+        for (r, m) in m.iter_mut().enumerate() {
+            if row.outside >> (2 * r) & 1 == 0 {
+                *m = occ[row.word[r] + w];
+            }
+        }
+        m
     }
 
-    fn sweep_row<S: BlockSink>(&self, sink: &mut S, rows: &[usize], oyz: [isize; 2], row_index: u64, reverse: bool) {
+    fn sweep_row<S: BlockSink>(&self, sink: &mut S, row: &BlockRow, reverse: bool) {
+        match S::CELLS {
+            4 => self.sweep_row_of::<S, 2>(sink, row, reverse),
+            _ => self.sweep_row_of::<S, 4>(sink, row, reverse),
+        }
+    }
+
+    /// Visits the occupied blocks of one row of blocks, whose blocks have
+    /// `ROWS` rows of two cells. Each word of the row's domain rows is read
+    /// once: the blocks' occupancy comes from the words the sweep holds.
+    /// Blocks only change their own cells, so a word read before a block
+    /// was visited still holds the right bits for every later block.
+    #[inline(always)]
+    fn sweep_row_of<S: BlockSink, const ROWS: usize>(&self, sink: &mut S, row: &BlockRow, reverse: bool) {
         let ax = self.axes[0];
         let words = self.row_words;
-        // Offset 1, not periodic: the half block (-1, 0) has block index 0
-        // and the pairs below start at index 1.
+        // The block's cells 2r, 2r + 1 from bits b, b + 1 of row word r.
+        let block = |m: &[u64; ROWS], b: usize| {
+            let mut bits = 0u8;
+            for r in 0..ROWS {
+                bits |= ((m[r] >> b) as u8 & 3) << (2 * r);
+            }
+            bits
+        };
+        // Offset 1, not periodic: the half block (-1, 0) has block index 0,
+        // its cell 1 in bit 0 of each row, and the pairs after it start at
+        // index 1.
         let half = self.offset == 1 && !ax.periodic;
         let half_block = |sink: &mut S| {
-            if Self::word(sink.occupancy(), rows, 0) & 1 != 0 {
-                sink.visit([-1, oyz[0], oyz[1]], row_index);
+            let first = Self::words::<ROWS>(sink.occupancy(), row, 0).map(|m| (m & 1) << 1);
+            let bits = block(&first, 0);
+            if bits != 0 {
+                sink.visit(row, -1, 0, bits);
             }
         };
         if half && !reverse {
@@ -134,35 +263,39 @@ impl Partition {
         }
         // Cell nx (one past the end) is cell 0 when periodic: read it before
         // any block of the row is visited (only the wrapping block holds it).
-        let wrap = self.offset == 1 && ax.periodic && Self::word(sink.occupancy(), rows, 0) & 1 != 0;
+        let wrap = if self.offset == 1 && ax.periodic {
+            Self::words::<ROWS>(sink.occupancy(), row, 0).map(|m| m & 1)
+        } else {
+            [0; ROWS]
+        };
         let last = (ax.n - 1) / 64;
         for j in 0..words {
             let w = if reverse { words - 1 - j } else { j };
             let occ = sink.occupancy();
-            let m = Self::word(occ, rows, w);
-            let fold = if self.offset == 0 {
-                // Pairs (2i, 2i+1): bit 2i of the fold.
-                (m | m >> 1) & EVEN
-            } else {
+            let mut m = Self::words::<ROWS>(occ, row, w);
+            if self.offset == 1 {
                 // Pairs (2i+1, 2i+2): shift so bit b is cell 64 w + b + 1.
-                let next = if w + 1 < words { Self::word(occ, rows, w + 1) & 1 } else { 0 };
-                let mut s = m >> 1 | next << 63;
-                if w == last && wrap {
-                    s |= 1 << ((ax.n - 1) % 64);
+                let next = if w + 1 < words { Self::words::<ROWS>(occ, row, w + 1) } else { [0; ROWS] };
+                for r in 0..ROWS {
+                    m[r] = m[r] >> 1 | next[r] << 63;
+                    if w == last {
+                        m[r] |= wrap[r] << ((ax.n - 1) % 64);
+                    }
                 }
-                (s | s >> 1) & EVEN
-            };
-            let mut bits = fold;
+            }
+            let any = m.iter().fold(0, |a, &x| a | x);
+            // Pair (2i, 2i+1) of the (shifted) words: bit 2i of the fold.
+            let mut bits = (any | any >> 1) & EVEN;
             while bits != 0 {
                 let b = if reverse { 63 - bits.leading_zeros() } else { bits.trailing_zeros() } as usize;
                 bits &= !(1u64 << b);
                 let pair = 32 * w + b / 2;
-                let (x0, bx) = if self.offset == 0 {
-                    (2 * pair as isize, pair)
+                let occ = block(&m, b);
+                if self.offset == 0 {
+                    sink.visit(row, 2 * pair as isize, pair, occ);
                 } else {
-                    (2 * pair as isize + 1, pair + usize::from(half))
-                };
-                sink.visit([x0, oyz[0], oyz[1]], row_index + bx as u64);
+                    sink.visit(row, 2 * pair as isize + 1, pair + usize::from(half), occ);
+                }
             }
         }
         if half && reverse {

@@ -1,9 +1,14 @@
 //! Quantized velocity storage (M1). A component `v` in `[-1, 1]` is stored as
-//! the integer nearest `v * SCALE`, rounded stochastically when it comes from
-//! the step, so the stored value is right on average: an acceleration below
-//! one quantum per step still acts, by raising the chance of rounding up.
+//! an integer near `v * SCALE`, rounded stochastically when it comes from the
+//! step, so the stored value is right on average: an acceleration below one
+//! quantum per step still acts, by raising the chance of rounding up.
+//!
+//! The step works in quanta: a velocity nothing changed is an integer and
+//! stays one, and M5.3's move decision is an integer comparison of 16 random
+//! bits against a threshold of the stored component ([`Quant::threshold`]).
 
-use rand_core::Rng;
+use crate::desc::Drift;
+use crate::rng::Stream;
 
 /// A stored velocity component type.
 pub(crate) trait Quant: Copy + Default + crate::world::Plain + 'static {
@@ -24,17 +29,84 @@ pub(crate) trait Quant: Copy + Default + crate::world::Plain + 'static {
         Self::from_int(libm::roundf(v.clamp(-1.0, 1.0) * Self::SCALE) as i32)
     }
 
-    /// Unbiased stochastic rounding of `x`, a velocity component in quanta
-    /// (`v * SCALE`): `E[result] = x` to within 2^-24 of a quantum. The step
-    /// works in quanta, so a velocity nothing changed is an exact integer and
-    /// is stored back unchanged without a draw.
-    #[inline]
-    fn stochastic<R: Rng + ?Sized>(x: f32, rng: &mut R) -> Self {
-        let x = x.clamp(-Self::SCALE, Self::SCALE);
-        let lo = libm::floorf(x);
-        let frac = x - lo;
-        let up = frac > 0.0 && crate::rng::chance(rng, frac);
-        Self::from_int(lo as i32 + i32::from(up))
+    /// Stochastic rounding of `x`, a velocity component in quanta (clamped
+    /// to the stored range), with 16 random bits `r`: `x` is put on a grid of
+    /// 2^-16 quanta (to nearest, halves away from zero, so no direction is
+    /// favoured), and the result is its integer part rounded down, plus one
+    /// when `r` is below the fraction's 16 bits. `E[result] = x` to within
+    /// 2^-17 of a quantum; an integer `x` is returned as it is.
+    #[inline(always)]
+    fn stochastic(x: f32, r: u32) -> i32 {
+        let x = x.clamp(-Self::SCALE, Self::SCALE) * 65536.0;
+        // |x| <= 32767 * 2^16 < 2^31: the cast does not saturate.
+        let fixed = (x + 0.5f32.copysign(x)) as i32;
+        (fixed >> 16) + i32::from(r & 0xffff < (fixed & 0xffff) as u32)
+    }
+
+    /// M1: every component of `x` (in quanta) rounded stochastically, from
+    /// one 64-bit output of the stream, 16 bits a component.
+    #[inline(always)]
+    fn round<const D: usize>(x: [f32; 3], rng: &mut Stream) -> [i32; D] {
+        let r = rng.next_u64();
+        let mut out = [0; D];
+        for k in 0..D {
+            out[k] = Self::stochastic(x[k], (r >> (16 * k)) as u32);
+        }
+        out
+    }
+
+    /// M5.3: whether 16 random bits `r` say "move" for a stored component
+    /// `q` (in quanta, not 0; its sign ignored) under `drift`: `r` below
+    /// `p 2^16` rounded, with `p` the drift rule's probability. `table` is
+    /// [`move_table_8`]'s table for `drift`, which 8-bit storage reads.
+    fn wants_move(table: &[u16; 256], drift: Drift, q: i32, r: u32) -> bool;
+}
+
+/// M5.3 for a velocity component `v` in cells per step (not an integer in
+/// quanta: one a stage changed this step): whether 16 random bits `r` say
+/// "move", `r` below `p 2^16` rounded, as [`Quant::wants_move`].
+#[inline]
+pub(crate) fn wants_move_f32(v: f32, drift: Drift, r: u32) -> bool {
+    let a = v.abs().min(1.0);
+    let p = match drift {
+        Drift::Paper => a,
+        Drift::Calibrated => 2.0 * a / (1.0 + a),
+    };
+    r < (p * 65536.0 + 0.5) as u32
+}
+
+/// `round(p 2^16)` for `p = a/127` (paper) and `p = 2a/(127 + a)`
+/// (calibrated), `a` in quanta, in integers so the tables are exact and the
+/// same on every target.
+const fn threshold_8(calibrated: bool, a: u32) -> u32 {
+    let (num, den) = if calibrated { (2 * a, 127 + a) } else { (a, 127) };
+    ((num << 17) + den) / (2 * den)
+}
+
+/// Per stored byte `q` (as `u8`), one less than the threshold of `|q|`:
+/// every `q != 0` has a threshold of at least 1 (516 at `|q| = 1`), so
+/// "below the threshold" is "at most the entry", and `|q| = 127` (p = 1)
+/// always moves with entry 65535.
+const fn move_table(calibrated: bool) -> [u16; 256] {
+    let mut t = [0; 256];
+    let mut b = 1;
+    while b < 256 {
+        let q = b as u8 as i8 as i32;
+        let a = if q < 0 { -q } else { q };
+        t[b] = (threshold_8(calibrated, if a > 127 { 127 } else { a } as u32) - 1) as u16;
+        b += 1;
+    }
+    t
+}
+
+static PAPER_8: [u16; 256] = move_table(false);
+static CALIBRATED_8: [u16; 256] = move_table(true);
+
+/// The 8-bit move table of a drift rule.
+pub(crate) fn move_table_8(drift: Drift) -> &'static [u16; 256] {
+    match drift {
+        Drift::Paper => &PAPER_8,
+        Drift::Calibrated => &CALIBRATED_8,
     }
 }
 
@@ -47,6 +119,10 @@ impl Quant for i8 {
     #[inline]
     fn to_int(self) -> i32 {
         i32::from(self)
+    }
+    #[inline]
+    fn wants_move(table: &[u16; 256], _: Drift, q: i32, r: u32) -> bool {
+        r <= u32::from(table[usize::from(q as u8)])
     }
 }
 
@@ -61,6 +137,12 @@ impl Quant for i16 {
     fn to_int(self) -> i32 {
         i32::from(self)
     }
+    #[inline]
+    fn wants_move(_: &[u16; 256], drift: Drift, q: i32, r: u32) -> bool {
+        // 32,768 thresholds would not fit a table; f32 holds a/32767 to
+        // 2^-24, far finer than the 2^-16 steps of the threshold.
+        wants_move_f32(q as f32 * (1.0 / Self::SCALE), drift, r)
+    }
 }
 
 #[cfg(test)]
@@ -68,36 +150,77 @@ mod tests {
     use super::*;
     use crate::rng::block_stream;
 
-    fn mean_of<Q: Quant>(v: f32, n: u32) -> f64 {
+    fn mean_of<Q: Quant>(x: f32, n: u32) -> f64 {
         let mut rng = block_stream(3, 0, 0);
-        (0..n).map(|_| f64::from(Q::stochastic(v, &mut rng).get())).sum::<f64>() / f64::from(n)
+        (0..n).map(|_| f64::from(Q::stochastic(x, rng.bits(16)))).sum::<f64>() / f64::from(n)
+    }
+
+    #[test]
+    fn rounding_up_happens_for_the_fraction_of_draws() {
+        // Expect: over all 2^16 values of r, x = lo + f rounds up for
+        // round(f 2^16) of them, for both signs and both widths.
+        for x in [10.3f32, -9.7, 0.3, -0.7, 0.0, 126.99, -126.01] {
+            let lo = libm::floorf(x);
+            let ups = (0..1u32 << 16).filter(|&r| i8::stochastic(x, r) == lo as i32 + 1).count() as f64;
+            assert!((ups - f64::from(x - lo) * 65536.0).abs() <= 1.0, "{x}: {ups}");
+        }
     }
 
     #[test]
     fn stochastic_rounding_is_unbiased() {
-        // v sits 0.3 quanta above a grid point; each draw is the lower point
-        // plus a Bernoulli(0.3) quantum, sd of the mean = q*sqrt(.21/n).
-        let mean = mean_of::<i8>(10.3, 100_000);
-        let q = 1.0 / 127.0;
-        let want = 10.3 * q;
-        let sd = q * (0.21f64 / 100_000.0).sqrt();
-        assert!((mean - want).abs() < 5.0 * sd, "{mean} vs {want}");
+        // x sits 0.3 quanta above a grid point (and below one, negative);
+        // each draw is the lower point plus a Bernoulli(0.3) quantum, sd of
+        // the mean = sqrt(.21/n) quanta.
+        let sd = (0.21f64 / 100_000.0).sqrt();
+        for (x, want) in [(10.3f32, 10.3f64), (-9.7, -9.7), (0.3, 0.3), (-0.7, -0.7)] {
+            let mean = mean_of::<i8>(x, 100_000);
+            assert!((mean - want).abs() < 5.0 * sd, "{x}: {mean} vs {want}");
+        }
     }
 
     #[test]
-    fn integers_in_quanta_draw_nothing() {
-        let mut rng = block_stream(0, 0, 0);
-        let mut twin = rng.clone();
+    fn integers_in_quanta_stay_put() {
         for q in -127..=127 {
-            assert_eq!(i8::stochastic(q as f32, &mut rng).to_int(), q);
+            for r in [0, 1, 0x7fff, 0xffff] {
+                assert_eq!(i8::stochastic(q as f32, r), q);
+            }
         }
-        assert_eq!(rng.next_u32(), twin.next_u32());
+        // Beyond the range: clamped.
+        assert_eq!(i8::stochastic(300.5, 0), 127);
+        assert_eq!(i8::stochastic(-1e30, 0xffff), -127);
+        #[cfg(feature = "q16")]
+        assert_eq!(i16::stochastic(-32767.0, 0), -32767);
     }
 
     #[test]
     fn nearest_round_trips_every_stored_value() {
         for q in -127..=127 {
             assert_eq!(i8::nearest(i8::from_int(q).get()).to_int(), q);
+        }
+    }
+
+    #[test]
+    fn move_decisions_follow_the_rounded_probabilities() {
+        // Expect: for every stored value but 0, exactly round(p 2^16) of the
+        // 2^16 values of r say "move" (within 0.5 of p 2^16; for 16-bit
+        // storage within 0.51, the f32 rounding of a/32767), all of them at
+        // full speed, for both widths and rules.
+        let moves = |f: &dyn Fn(u32) -> bool| (0..1u32 << 16).filter(|&r| f(r)).count() as f64;
+        for drift in [Drift::Paper, Drift::Calibrated] {
+            let p = |a: f64| if drift == Drift::Paper { a } else { 2.0 * a / (1.0 + a) };
+            let table = move_table_8(drift);
+            for q in (-127..=127).filter(|&q| q != 0) {
+                let want = p(f64::from(q).abs() / 127.0) * 65536.0;
+                let got = moves(&|r| i8::wants_move(table, drift, q, r));
+                assert!((got - want).abs() <= 0.5, "{drift:?} {q}: {got} vs {want}");
+            }
+            assert_eq!(moves(&|r| i8::wants_move(table, drift, -127, r)), 65536.0);
+            #[cfg(feature = "q16")]
+            for q in [-32767, -20000, -1, 1, 777, 32767] {
+                let want = p(f64::from(q).abs() / 32767.0) * 65536.0;
+                let got = moves(&|r| i16::wants_move(table, drift, q, r));
+                assert!((got - want).abs() <= 0.51, "{drift:?} {q}: {got} vs {want}");
+            }
         }
     }
 }

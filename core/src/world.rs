@@ -28,6 +28,20 @@ unsafe impl Plain for u16 {}
 unsafe impl Plain for i16 {}
 unsafe impl Plain for u64 {}
 unsafe impl Plain for f32 {}
+// SAFETY: an array of plain values is plain: no padding between elements,
+// and every element accepts every bit pattern.
+unsafe impl<T: Plain, const N: usize> Plain for [T; N] {}
+
+/// Views a plane of `T` as whole groups of `N` (a cell's `N` velocity
+/// components, say); a partial group at the end is left out.
+#[inline]
+pub(crate) fn groups<T: Plain, const N: usize>(plane: &mut [T]) -> &mut [[T; N]] {
+    const { assert!(N > 0) };
+    // SAFETY: `[T; N]` has the alignment of `T` and the size of N of them,
+    // the length is rounded down to whole groups, any bit pattern is a valid
+    // `[T; N]` (Plain), and the borrow of `plane` is carried over.
+    unsafe { core::slice::from_raw_parts_mut(plane.as_mut_ptr().cast::<[T; N]>(), plane.len() / N) }
+}
 
 /// Views `bytes` as a slice of `T`. Planes start 8-byte aligned by
 /// construction of [`Layout`] and the header's alignment.
@@ -500,16 +514,17 @@ impl World {
 
     /// Writes a particle into a free cell. Components are rounded
     /// stochastically from `stream` when one is given (M1), else to nearest.
-    pub(crate) fn place(&mut self, s: Site, v: [f32; 3], class: u8, life: u16, mut stream: Option<&mut crate::rng::Stream>) {
+    pub(crate) fn place(&mut self, s: Site, v: [f32; 3], class: u8, life: u16, stream: Option<&mut crate::rng::Stream>) {
         let d = self.dim();
         let per_mass = self.head.desc.per_particle_mass;
         let lifetimes = self.head.desc.lifetimes;
         with_quant!(self.head.desc.quantization, Q => {
             let (_, p) = self.planes::<Q>();
             put_bit(p.occupancy, s.bit, true);
+            let r = stream.map(|rng| rng.next_u64());
             for k in 0..d {
-                p.velocity[s.cell * d + k] = match stream.as_deref_mut() {
-                    Some(rng) => Q::stochastic(v[k] * Q::SCALE, rng),
+                p.velocity[s.cell * d + k] = match r {
+                    Some(r) => Q::from_int(Q::stochastic(v[k] * Q::SCALE, (r >> (16 * k)) as u32)),
                     None => Q::nearest(v[k]),
                 };
             }

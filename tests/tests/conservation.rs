@@ -224,11 +224,19 @@ fn slow_boxes() -> Vec<(String, Outcome)> {
 
 /// As `slow_boxes`, with per-particle masses 0.5, 1 and 2 (M9), which
 /// exercise the mass shares of eqs. 7-8.
+///
+/// Speeds start below 0.15, not 0.3: collisions share the energy out
+/// evenly (equipartition), so the light particles end up faster than the
+/// rest, and at 0.3 a particle of mass 0.5 has mean square speed about
+/// 0.105 and exceeds 1 (a clamp) with probability about e^(-1/0.105) ~ 7e-5
+/// per collision it leaves: a couple of clamps in 20,000 collisions, which
+/// the no-clamp bands below cannot allow for. At 0.15 the mean square speed
+/// is a quarter of that and the chance about e^-38 per collision.
 fn mixed_boxes() -> Vec<(String, Outcome)> {
     let mut v = vec![];
     for q in [Quantization::Bits8, Quantization::Bits16] {
         let masses: &[f32] = &[1.0, 0.5, 2.0];
-        let two = Scene { dim: 2, q, n: 64, count: 1000, max_speed: 0.3, steps: 300, seed: 23, masses };
+        let two = Scene { dim: 2, q, n: 64, count: 1000, max_speed: 0.15, steps: 300, seed: 23, masses };
         v.push((format!("2D {q:?} mixed masses"), closed_box(&two)));
         let three = Scene { dim: 3, n: 24, count: 2000, steps: 200, seed: 24, ..two };
         v.push((format!("3D {q:?} mixed masses"), closed_box(&three)));
@@ -245,7 +253,7 @@ fn mixed_boxes() -> Vec<(String, Outcome)> {
 #[test]
 fn momentum_is_conserved_in_a_closed_box() {
     for (name, o) in slow_boxes().into_iter().chain(mixed_boxes()) {
-        assert_eq!(o.clamps, 0, "{name}: a clamp fired");
+        assert_eq!(o.clamps, 0, "{name}: a clamp fired ({} clamps, {} collisions)", o.clamps, o.collisions);
         assert_eq!(o.clamp_energy, 0.0, "{name}: clamped energy without a clamp");
         assert!(o.collisions > 5000, "{name}: only {} collisions", o.collisions);
         let band = Z * o.momentum_var.sqrt() + o.momentum_slack;
@@ -277,7 +285,7 @@ fn masses_travel_with_their_particles() {
 #[test]
 fn kinetic_energy_is_conserved_with_e_1() {
     for (name, o) in slow_boxes().into_iter().chain(mixed_boxes()) {
-        assert_eq!(o.clamps, 0, "{name}: a clamp fired");
+        assert_eq!(o.clamps, 0, "{name}: a clamp fired ({} clamps, {} collisions)", o.clamps, o.collisions);
         let change = o.end.energy - o.start.energy;
         let sd = o.energy_var.sqrt();
         let (lo, hi) = (-Z * sd - o.energy_slack, o.energy_bias + Z * sd + o.energy_slack);

@@ -404,22 +404,26 @@ fn flat_floor_reflects_exactly() {
 /// normal component's sign flipped.
 #[test]
 fn inelastic_and_tilted_walls_reflect_within_rounding() {
-    // (normal of the half-space through (32, 16, 0), restitution). Particles
-    // start at x in 28..40, y = 30, falling, so each meets the plane well
-    // above the domain's floor.
+    // (normal of the half-space through (32, 32, 0), restitution). Particles
+    // start at x in 28..40, y = 46, falling with |v_x| <= 0.3 against
+    // v_y = -0.7, so each meets the plane well above the domain's floor:
+    // along their paths every plane lies at y >= 15 (with the plane through
+    // (32, 16) and a start at y = 30, the tilted planes came within two
+    // cells of the floor, and a particle could miss them by chance).
     let h = std::f64::consts::FRAC_1_SQRT_2;
     for (normal, e) in [([0.0f64, 1.0, 0.0], 0.5f32), ([h, h, 0.0], 1.0), ([-0.6, 0.8, 0.0], 0.8)] {
         let planes = 12u32;
-        let mut desc = world_with_obstacles(Description::new_3d(64, 32, 4 * planes));
+        let mut desc = world_with_obstacles(Description::new_3d(64, 64, 4 * planes));
+        desc.surface_capacity = 16384;
         desc.boundary[1] = [Boundary::Wall; 2];
         desc.seed = 82;
         let mut mem = memory(&desc);
         let world = World::init(&desc, &mut mem).unwrap();
         let nf = normal.map(|c| c as f32);
-        world.add_shape(Shape::HalfSpace { point: [32.0, 16.0, 0.0], normal: nf }, e).unwrap();
+        world.add_shape(Shape::HalfSpace { point: [32.0, 32.0, 0.0], normal: nf }, e).unwrap();
         for j in 0..planes {
             let vx = -0.3 + 0.6 * j as f32 / planes as f32;
-            world.add_particle([28 + j, 30, 4 * j], [vx, -0.7, 0.0]).unwrap();
+            world.add_particle([28 + j, 46, 4 * j], [vx, -0.7, 0.0]).unwrap();
         }
         // Every surface cell of a half-space has the same stored normal.
         let n = common::cells(&desc).find_map(|p| world.surface(p)).unwrap().normal.map(f64::from);

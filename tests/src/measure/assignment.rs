@@ -46,7 +46,7 @@ fn solve(dim: u32, method: Method, problems: &[MoveProblem], seed: u64) -> Vec<A
     let mut rng = block_stream(seed, 0, 0);
     problems
         .iter()
-        .map(|p| if dim == 2 { assign_moves::<2, _>(method, p, &mut rng) } else { assign_moves::<3, _>(method, p, &mut rng) })
+        .map(|p| if dim == 2 { assign_moves::<2>(method, p, &mut rng) } else { assign_moves::<3>(method, p, &mut rng) })
         .collect()
 }
 

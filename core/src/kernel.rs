@@ -1,0 +1,626 @@
+//! The local map of M5 on one block: the step's inner loop.
+//!
+//! One routine for 2D and 3D reads a block from what the sweep hands it (its
+//! occupancy bits, the block row's addresses), keeps the velocities nothing
+//! changed as the stored integers (in quanta), decides the moves of M5.3 by
+//! comparing 16 random bits with a table entry of the stored component,
+//! assigns moves in 2D with one look-up in a table of every block state's
+//! optimal assignments, and writes back only what changed: a block where
+//! nothing moved and no velocity changed writes nothing. A velocity a stage
+//! changes (a force, a collision, a reflection) is kept in `f32` quanta,
+//! clamped after each stage (M5.5) and rounded once, when it is written
+//! back (M1).
+//!
+//! [`Kernel::lean`] is the same routine for the common case, blocks of a
+//! plain world (no obstacles, one mass, no lifetimes, at most a uniform
+//! force) away from the faces, without the code for what such a block
+//! cannot hold; [`Kernel::general`] handles everything. Both draw the same
+//! numbers in the same order, so they give the same world bit for bit, and
+//! the tests hold them to it.
+//!
+//! Every draw of a block comes from its stream (M8), in this order:
+//! 1. M5.2, if the block holds two particles or more, the pair (16 bits);
+//!    if both cells of the pair hold one, the unit vector `R` (32 or 48
+//!    bits a try);
+//! 2. M5.3 and M5.4, per particle in cell order that could move inside the
+//!    block along some axis, 16 bits per axis (32 bits, then 16 in 3D);
+//! 3. M5.6, the tie-break of the assignment, where there is a choice;
+//! 4. M1, per particle in cell order whose velocity a stage changed and
+//!    that stays in the world, one 64-bit output for its rounding.
+//!
+//! M5.1 draws nothing.
+
+use crate::assign::{assign_moves, optimal_moves_2d, pick_move, Method, MoveProblem, PLACE_2D};
+use crate::collision::{block_pairs, collide_pair, pair_holds_two, random_unit, shares};
+use crate::desc::Description;
+use crate::force::ForceTerms;
+use crate::obstacle::{reflect, surface_at, Surface};
+use crate::partition::{cells_at, resolve, BlockRow, BlockSink, Beyond, Partition};
+use crate::quant::{Quant, wants_move_f32};
+use crate::rng::{StepKey, Stream};
+use crate::vector::{clamp, dot, normalise};
+use crate::world::{put_bit, Counters, ENERGY_SCALE};
+
+/// What every block of a step reads and none writes.
+pub(crate) struct Shared<'a> {
+    pub desc: Description,
+    pub n: [usize; 3],
+    pub part: Partition,
+    pub key: StepKey,
+    pub obstacle: &'a [u64],
+    pub surface: &'a [Surface],
+    pub mass_table: &'a [f32],
+    pub terms: ForceTerms<'a>,
+    /// The uniform force's velocity change per step in quanta, where it
+    /// changes anything (the general force path includes it in `terms`).
+    pub push: Option<[f32; 3]>,
+    /// `dt * SCALE`: turns an acceleration into quanta per step.
+    pub dt_q: f32,
+    /// The 8-bit move table of the drift rule (M5.3).
+    pub moves: &'static [u16; 256],
+    /// No obstacles, one mass, no lifetimes: blocks away from the faces go
+    /// through [`Kernel::lean`].
+    pub plain: bool,
+}
+
+/// The planes a step writes; `velocity` holds a cell's `D` components
+/// together.
+pub(crate) struct Writable<'a, Q, const D: usize> {
+    pub occupancy: &'a mut [u64],
+    pub velocity: &'a mut [[Q; D]],
+    pub mass_index: &'a mut [u8],
+    pub life: &'a mut [u16],
+}
+
+/// The block routine, specialised once per step (M9) on the stored velocity
+/// type `Q`, the dimension `D` (with `CELLS = 2^D` cells a block) and
+/// whether forces other than a uniform one are summed (`GENERAL`).
+/// Obstacles, per-particle masses and lifetimes are per-step switches: each
+/// costs a predictable branch per block or per particle when it is off.
+pub(crate) struct Kernel<'a, Q, const D: usize, const CELLS: usize, const GENERAL: bool> {
+    pub shared: &'a Shared<'a>,
+    pub planes: Writable<'a, Q, D>,
+    pub counters: Counters,
+}
+
+/// Per 2D blocked mask, the part of the table key its cells contribute
+/// (digit 1 each, M5.6).
+const BLOCKED_KEY_2D: [u16; 16] = {
+    let mut t = [0; 16];
+    let mut mask = 0;
+    while mask < 16 {
+        let mut c = 0;
+        while c < 4 {
+            if mask >> c & 1 != 0 {
+                t[mask] += PLACE_2D[c];
+            }
+            c += 1;
+        }
+        mask += 1;
+    }
+    t
+};
+
+/// Targets of a block's cells, 4 bits a cell (cell `c` goes to
+/// `targets >> 4c & 7`): per occupancy mask the bits that belong to
+/// occupied cells, and the targets that leave every particle in place.
+const FIELDS: [u32; 256] = {
+    let mut t = [0; 256];
+    let mut mask = 0;
+    while mask < 256 {
+        let mut c = 0;
+        while c < 8 {
+            if mask >> c & 1 != 0 {
+                t[mask] |= 0xf << (4 * c);
+            }
+            c += 1;
+        }
+        mask += 1;
+    }
+    t
+};
+const IDENTITY: u32 = 0x7654_3210;
+
+/// A 2D table move's 2-bit targets (one byte) spread to 4 bits a cell.
+const SPREAD_2D: [u32; 256] = {
+    let mut t = [0; 256];
+    let mut b = 0;
+    while b < 256 {
+        let mut c = 0;
+        while c < 4 {
+            t[b] |= ((b as u32 >> (2 * c)) & 3) << (4 * c);
+            c += 1;
+        }
+        b += 1;
+    }
+    t
+};
+
+/// Runs `$body` once for each cell of a block of `$cells` cells, with `$c`
+/// bound to the cell's number as a constant: every index, side and table
+/// entry derived from the cell folds at compile time, where a loop over the
+/// cells would be left rolled.
+macro_rules! each_cell {
+    ($cells:expr, $c:ident => $body:block) => {{
+        { let $c: usize = 0; $body }
+        { let $c: usize = 1; $body }
+        { let $c: usize = 2; $body }
+        { let $c: usize = 3; $body }
+        if $cells > 4 {
+            { let $c: usize = 4; $body }
+            { let $c: usize = 5; $body }
+            { let $c: usize = 6; $body }
+            { let $c: usize = 7; $body }
+        }
+    }};
+}
+
+/// Iterates the set bits of a block mask, lowest first.
+#[inline]
+pub(crate) fn cells_of(mut mask: u8) -> impl Iterator<Item = usize> {
+    core::iter::from_fn(move || {
+        (mask != 0).then(|| {
+            let c = mask.trailing_zeros() as usize;
+            mask &= mask - 1;
+            c
+        })
+    })
+}
+
+/// The bits of a block in a bit plane, bit `c` for cell `c` (x `xs[c & 1]`
+/// in the block row `c >> 1` whose words start at `row.word`): one read per
+/// block row where its two cells share a word.
+#[inline(always)]
+fn read_block<const CELLS: usize>(plane: &[u64], row: &BlockRow, xs: [usize; 2]) -> u8 {
+    let mut bits = 0u8;
+    if xs[1] == xs[0] + 1 && xs[0] & 63 != 63 {
+        let (w, s) = (xs[0] >> 6, xs[0] & 63);
+        for r in 0..CELLS / 2 {
+            bits |= ((plane[row.word[r] + w] >> s) as u8 & 3) << (2 * r);
+        }
+    } else {
+        for c in 0..CELLS {
+            let b = xs[c & 1] + 64 * row.word[c >> 1];
+            bits |= ((plane[b >> 6] >> (b & 63)) as u8 & 1) << c;
+        }
+    }
+    bits
+}
+
+/// A unit normal from cell `to` back towards cell `from` of the same block.
+pub(crate) fn back_normal<const D: usize>(from: usize, to: usize) -> [f32; 3] {
+    let mut n = [0.0f32; 3];
+    for (k, nk) in n.iter_mut().enumerate().take(D) {
+        *nk = ((from >> k) & 1) as f32 - ((to >> k) & 1) as f32;
+    }
+    normalise(n).unwrap_or([0.0; 3])
+}
+
+/// M5.5: clamps `x` (in quanta) to the speed limit `scale`, counting the
+/// clamp and the kinetic energy it removed for mass `m`.
+#[inline(always)]
+fn clamp_counted(x: &mut [f32; 3], scale: f32, m: f32, counters: &mut Counters) {
+    if let Some(s2) = clamp(x, scale) {
+        count_clamp(s2 / (scale * scale), m, counters);
+    }
+}
+
+/// Counts a clamp of a particle of mass `m` whose squared speed was `s2`
+/// (cells per step), and the kinetic energy it removed.
+#[cold]
+fn count_clamp(s2: f32, m: f32, counters: &mut Counters) {
+    counters.clamps += 1;
+    let fixed = (0.5 * f64::from(m) * (f64::from(s2) - 1.0) * ENERGY_SCALE) as u128; // saturating cast
+    counters.clamp_energy = counters.clamp_energy.saturating_add(fixed);
+}
+
+/// A blocked cell a particle wants (M5.4): its number in the block, its
+/// dense index in the planes (meaningless beyond a face), its coordinates
+/// (possibly beyond a face) and whether it lies beyond a wall.
+#[derive(Clone, Copy)]
+struct Wanted {
+    cell: usize,
+    site: usize,
+    at: [i64; 3],
+    wall: bool,
+}
+
+/// A block's particles as the stages of M5 see them.
+struct Block<const D: usize, const CELLS: usize> {
+    /// Cells holding a particle.
+    occ: u8,
+    /// Stored velocities in quanta; what an empty cell holds is never read.
+    stored: [[i32; D]; CELLS],
+    /// Cells whose velocity a stage changed: it is `moved[c]`, in quanta,
+    /// not yet rounded.
+    changed: u8,
+    moved: [[f32; 3]; CELLS],
+}
+
+impl<const D: usize, const CELLS: usize> Block<D, CELLS> {
+    /// The velocity of the particle in cell `c`, in quanta.
+    #[inline(always)]
+    fn velocity(&self, c: usize) -> [f32; 3] {
+        if self.changed >> c & 1 != 0 {
+            return self.moved[c];
+        }
+        let mut x = [0.0; 3];
+        for k in 0..D {
+            x[k] = self.stored[c][k] as f32;
+        }
+        x
+    }
+
+    #[inline(always)]
+    fn set(&mut self, c: usize, x: [f32; 3]) {
+        self.moved[c] = x;
+        self.changed |= 1 << c;
+    }
+}
+
+impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'_, Q, D, CELLS, GENERAL> {
+    const ALL: u8 = {
+        assert!(CELLS == 1 << D && (D == 2 || D == 3));
+        (u8::MAX as usize >> (8 - CELLS)) as u8
+    };
+
+    /// The block's particles: their stored velocities, read a block row (two
+    /// neighbouring cells) at a time where the row does not wrap.
+    #[inline(always)]
+    fn load(&self, row: &BlockRow, xs: [usize; 2], occ: u8) -> Block<D, CELLS> {
+        let mut b = Block { occ, stored: [[0; D]; CELLS], changed: 0, moved: [[0.0; 3]; CELLS] };
+        let velocity = &*self.planes.velocity;
+        if xs[1] == xs[0] + 1 {
+            for r in 0..CELLS / 2 {
+                if occ >> (2 * r) & 3 != 0 {
+                    let at = xs[0] + row.cell[r];
+                    let pair = &velocity[at..at + 2];
+                    b.stored[2 * r] = pair[0].map(Q::to_int);
+                    b.stored[2 * r + 1] = pair[1].map(Q::to_int);
+                }
+            }
+        } else {
+            for c in cells_of(occ) {
+                b.stored[c] = velocity[xs[c & 1] + row.cell[c >> 1]].map(Q::to_int);
+            }
+        }
+        b
+    }
+
+    /// M5.1 for the particle in cell `c` of mass `m`: `v <- v + dv` (dv in
+    /// quanta, eqs. 4-5), then the clamp.
+    #[inline(always)]
+    fn push(&mut self, b: &mut Block<D, CELLS>, c: usize, dv: [f32; 3], m: f32) {
+        let mut x = b.velocity(c);
+        for k in 0..D {
+            x[k] += dv[k];
+        }
+        clamp_counted(&mut x, Q::SCALE, m, &mut self.counters);
+        b.set(c, x);
+    }
+
+    /// M5.2: one of the block's pairs, uniformly; if both its cells hold a
+    /// particle, eqs. 7-8 with `R` uniform, then the clamp. `mass` gives a
+    /// cell's mass; `equal` says every mass is the same.
+    #[inline(always)]
+    fn collide(&mut self, b: &mut Block<D, CELLS>, rng: &mut Stream, mass: impl Fn(usize) -> f32, equal: bool) {
+        if b.occ & (b.occ - 1) == 0 {
+            return;
+        }
+        let pairs = block_pairs::<D>();
+        let p = rng.below(pairs.len() as u32);
+        if !pair_holds_two::<D>(b.occ, p) {
+            return;
+        }
+        let (a, c) = pairs[p as usize];
+        let (a, c) = (usize::from(a), usize::from(c));
+        let r = random_unit::<D>(rng);
+        let (ma, mc) = (mass(a), mass(c));
+        let s = if equal { (0.5, 0.5) } else { shares(ma, mc) };
+        let (mut xa, mut xc) = collide_pair(b.velocity(a), b.velocity(c), s, self.shared.desc.restitution, r);
+        self.counters.collisions += 1;
+        clamp_counted(&mut xa, Q::SCALE, ma, &mut self.counters);
+        clamp_counted(&mut xc, Q::SCALE, mc, &mut self.counters);
+        b.set(a, xa);
+        b.set(c, xc);
+    }
+
+    /// M5.3: the axes the particle in cell `c` wants to cross. Only a move
+    /// that stays inside the block can be wanted: towards +k from the low
+    /// side of the block, towards -k from the high.
+    #[inline(always)]
+    fn decide(&self, b: &Block<D, CELLS>, c: usize, rng: &mut Stream) -> u8 {
+        let desc = &self.shared.desc;
+        let exact = b.changed >> c & 1 == 0;
+        let x = b.moved[c];
+        let mut inward = 0u8;
+        for k in 0..D {
+            let low = (c >> k) & 1 == 0;
+            let positive = if exact { b.stored[c][k] > 0 } else { x[k] > 0.0 };
+            let negative = if exact { b.stored[c][k] < 0 } else { x[k] < 0.0 };
+            inward |= u8::from(if low { positive } else { negative }) << k;
+        }
+        if inward == 0 {
+            return 0;
+        }
+        let r = if D == 2 { u64::from(rng.bits(32)) } else { u64::from(rng.bits(32)) | u64::from(rng.bits(16)) << 32 };
+        let mut m = 0u8;
+        for k in 0..D {
+            let bits = (r >> (16 * k)) as u32 & 0xffff;
+            let go = if exact {
+                Q::wants_move(self.shared.moves, desc.drift, b.stored[c][k], bits)
+            } else {
+                wants_move_f32(x[k] * (1.0 / Q::SCALE), desc.drift, bits)
+            };
+            m |= u8::from(inward >> k & 1 != 0 && go) << k;
+        }
+        m
+    }
+
+    /// M5.4: the particle in cell `c` of mass `m` wants the blocked cell
+    /// `to`: reflect its velocity off that cell's surface (eq. 9) and clamp
+    /// it. Rare, so kept out of the block routine's straight line.
+    #[cold]
+    #[inline(never)]
+    fn reflect_off(&mut self, b: &mut Block<D, CELLS>, c: usize, to: Wanted, m: f32) {
+        let sh = self.shared;
+        let t = to.cell;
+        let mut surface = None;
+        if to.wall {
+            if let Beyond::Wall(n) = resolve(sh.n, &sh.desc.boundary, to.at) {
+                surface = Some((n, sh.desc.wall_restitution));
+            }
+        }
+        let (n, e) = surface.unwrap_or_else(|| match surface_at(sh.surface, to.site as u32) {
+            Some(s) => (s.normal, s.restitution),
+            // Unreachable for obstacles added through the API (every cell
+            // next to a free one has an entry): the direction back to the
+            // particle.
+            None => (back_normal::<D>(c, t), sh.desc.wall_restitution),
+        });
+        let x = b.velocity(c);
+        // A normal that does not face the incoming particle (a half-space
+        // seen across a periodic seam, a mask corner) would leave it
+        // pressing on the obstacle for ever: reflect off the face it came
+        // through instead.
+        let n = if dot(x, n) < 0.0 { n } else { back_normal::<D>(c, t) };
+        let mut x = reflect(x, n, e); // eq. 9
+        clamp_counted(&mut x, Q::SCALE, m, &mut self.counters);
+        b.set(c, x);
+    }
+
+    /// M5.6: where each particle goes, `targets >> 4c & 7` for the particle
+    /// in cell `c`, counting those not placed in their desired cell. `want`
+    /// holds the axes each wants to cross; `key` is the 2D table key.
+    #[inline(always)]
+    fn assign(&mut self, b: &Block<D, CELLS>, blocked: u8, want: &[u8; CELLS], key: usize, rng: &mut Stream) -> u32 {
+        let method = self.shared.desc.method;
+        if D == 2 && method == Method::ExactFast {
+            let packed = pick_move(optimal_moves_2d(key), rng);
+            self.counters.displaced += u64::from(packed >> 12);
+            // 2 bits a cell in the table; 4 here, as in 3D.
+            return SPREAD_2D[usize::from(packed as u8)];
+        }
+        let mut problem = MoveProblem { free: !blocked & Self::ALL, count: b.occ.count_ones() as usize, ..MoveProblem::default() };
+        for (i, c) in cells_of(b.occ).enumerate() {
+            problem.current[i] = c as u8;
+            problem.desired[i] = c as u8 ^ want[c];
+            if method == Method::Greedy {
+                let x = b.velocity(c);
+                problem.speed2[i] = dot(x, x);
+            }
+        }
+        let moves = assign_moves::<D>(method, &problem, rng);
+        let mut targets = 0u32;
+        for i in 0..problem.count {
+            targets |= u32::from(moves.target[i]) << (4 * problem.current[i]);
+            self.counters.displaced += u64::from(moves.target[i] != problem.desired[i]);
+        }
+        targets
+    }
+
+    /// Writes the particle of cell `c` to cell `to` of the planes: its
+    /// stored velocity, or a changed one rounded (M1).
+    #[inline(always)]
+    fn store(&mut self, b: &Block<D, CELLS>, c: usize, to: usize, rng: &mut Stream) {
+        self.planes.velocity[to] = if b.changed >> c & 1 != 0 {
+            Q::round::<D>(b.moved[c], rng).map(Q::from_int)
+        } else {
+            b.stored[c].map(Q::from_int)
+        };
+    }
+
+    /// Sets and clears the block's occupancy bits from `before` to `after`.
+    #[inline(always)]
+    fn occupy(&mut self, row: &BlockRow, xs: [usize; 2], before: u8, after: u8) {
+        let bit = |c: usize| xs[c & 1] + 64 * row.word[c >> 1];
+        for c in cells_of(before & !after) {
+            put_bit(self.planes.occupancy, bit(c), false);
+        }
+        for c in cells_of(after & !before) {
+            put_bit(self.planes.occupancy, bit(c), true);
+        }
+    }
+
+    /// The local map of M5 on a block of a plain world (no obstacles, one
+    /// mass, no lifetimes, no force but a uniform one) away from the faces:
+    /// [`Kernel::general`] without what such a block cannot have. Cell `c`
+    /// has x `xs[c & 1]` in block row `c >> 1`.
+    #[inline(always)]
+    fn lean(&mut self, row: &BlockRow, xs: [usize; 2], index: u64, occ: u8) {
+        let sh = self.shared;
+        let mass = sh.desc.mass;
+        let mut b = self.load(row, xs, occ);
+        let mut rng = sh.key.stream(index);
+        if let Some(dv) = sh.push {
+            for c in cells_of(occ) {
+                self.push(&mut b, c, dv, mass);
+            }
+        }
+        self.collide(&mut b, &mut rng, |_| mass, true);
+        let mut want = [0u8; CELLS];
+        let mut key = 0;
+        each_cell!(CELLS, c => {
+            if occ >> c & 1 != 0 {
+                want[c] = self.decide(&b, c, &mut rng);
+                if D == 2 {
+                    key += usize::from(PLACE_2D[c & 3]) * usize::from(2 + want[c]);
+                }
+            }
+        });
+        let targets = self.assign(&b, 0, &want, key, &mut rng);
+        self.counters.processed += 1;
+        if (targets ^ IDENTITY) & FIELDS[usize::from(occ)] == 0 && b.changed == 0 {
+            return;
+        }
+        let cell = |c: usize| xs[c & 1] + row.cell[c >> 1];
+        let mut after = 0u8;
+        each_cell!(CELLS, c => {
+            if occ >> c & 1 != 0 {
+                let t = (targets >> (4 * c) & 7) as usize;
+                after |= 1 << t;
+                if t != c || b.changed >> c & 1 != 0 {
+                    self.store(&b, c, cell(t), &mut rng);
+                }
+            }
+        });
+        self.occupy(row, xs, occ, after);
+    }
+
+    /// The local map of M5 on any block: the half blocks on faces that are
+    /// not periodic, blocks with obstacles, per-particle masses, lifetimes
+    /// or forces other than a uniform one.
+    #[inline(never)]
+    fn general(&mut self, row: &BlockRow, x0: isize, bx: usize, occ: u8) {
+        let sh = self.shared;
+        let desc = &sh.desc;
+
+        // M3, M4: the block's cells. Cell c lies at x xs[c & 1] of block row
+        // c >> 1 (y, then z).
+        let (xs, x_out) = sh.part.axis_pair(0, x0);
+        let cell = |c: usize| xs[c & 1] + row.cell[c >> 1];
+        let at = |c: usize| [x0 as i64 + (c & 1) as i64, row.origin[0] as i64 + ((c >> 1) & 1) as i64, row.origin[1] as i64 + ((c >> 2) & 1) as i64];
+        let mut outside = row.outside;
+        if x_out != 0 {
+            let low = if x_out & 1 != 0 { cells_at(0, 0, D) } else { 0 };
+            outside |= low | if x_out & 2 != 0 { cells_at(0, 1, D) } else { 0 };
+        }
+        // The cells beyond a face are wall or open (their sites mean
+        // nothing).
+        let (mut wall, mut open) = (0u8, 0u8);
+        for c in cells_of(outside & Self::ALL) {
+            match resolve(sh.n, &desc.boundary, at(c)) {
+                Beyond::Wall(_) => wall |= 1 << c,
+                _ => open |= 1 << c,
+            }
+        }
+        let blocked = wall | if desc.obstacles { read_block::<CELLS>(sh.obstacle, row, xs) & !outside & Self::ALL } else { 0 };
+
+        let mut b = self.load(row, xs, occ);
+        let mut mass = [desc.mass; CELLS];
+        let mut class = [0u8; CELLS];
+        let mut life = [0u16; CELLS];
+        for c in cells_of(occ) {
+            if desc.per_particle_mass {
+                class[c] = self.planes.mass_index[cell(c)];
+                mass[c] = sh.mass_table[usize::from(class[c])];
+            }
+            if desc.lifetimes {
+                life[c] = self.planes.life[cell(c)];
+            }
+        }
+        let mut rng = sh.key.stream(row.index + bx as u64);
+
+        // M5.1 external force: v <- v + dt F / m (eqs. 4-5).
+        for c in cells_of(occ) {
+            let dv = if GENERAL {
+                let pos = sh.part.cell_coords(row, [xs[c & 1], 0, 0], c);
+                // dt = 0 changes nothing, even under an infinite force
+                // (0 * inf would be NaN).
+                let a = sh.terms.accel(pos, cell(c), mass[c]);
+                a.map(|a| if sh.dt_q == 0.0 { 0.0 } else { a * sh.dt_q })
+            } else {
+                sh.push.unwrap_or_default()
+            };
+            // A force that changes nothing is no step 1: a zero-valued part
+            // gives the same world as a world without it (M9).
+            if dv != [0.0; 3] {
+                self.push(&mut b, c, dv, mass[c]);
+            }
+        }
+
+        // M5.2 collision.
+        self.collide(&mut b, &mut rng, |c| mass[c], !desc.per_particle_mass);
+
+        // M5.3 desired move, M5.4 obstacle reflection: `want[c]` holds the
+        // axes the particle in cell c wants to cross.
+        let mut want = [0u8; CELLS];
+        let mut key = if D == 2 { usize::from(BLOCKED_KEY_2D[usize::from(blocked & 15)]) } else { 0 };
+        for c in cells_of(occ) {
+            let mut m = self.decide(&b, c, &mut rng);
+            let t = c ^ usize::from(m);
+            if m != 0 && blocked >> t & 1 != 0 {
+                let to = Wanted { cell: t, site: cell(t), at: at(t), wall: wall >> t & 1 != 0 };
+                self.reflect_off(&mut b, c, to, mass[c]);
+                m = 0;
+            }
+            want[c] = m;
+            if D == 2 {
+                key += usize::from(PLACE_2D[c & 3]) * usize::from(2 + m);
+            }
+        }
+
+        // M5.6 move.
+        let targets = self.assign(&b, blocked, &want, key, &mut rng);
+
+        // Write back what changed.
+        self.counters.processed += 1;
+        if (targets ^ IDENTITY) & FIELDS[usize::from(occ)] == 0 && b.changed == 0 && !desc.lifetimes {
+            return;
+        }
+        let mut after = 0u8;
+        for c in cells_of(occ) {
+            let t = (targets >> (4 * c) & 7) as usize;
+            // A lifetime is 0 (none) in worlds without lifetimes.
+            if open >> t & 1 != 0 {
+                self.counters.exited += 1; // M4 open face
+            } else if life[c] == 1 {
+                self.counters.expired += 1; // M6 lifetime
+            } else {
+                after |= 1 << t;
+                let to = cell(t);
+                if t != c || b.changed >> c & 1 != 0 {
+                    self.store(&b, c, to, &mut rng);
+                }
+                if desc.per_particle_mass && t != c {
+                    self.planes.mass_index[to] = class[c];
+                }
+                if desc.lifetimes {
+                    self.planes.life[to] = life[c].saturating_sub(1);
+                }
+            }
+        }
+        self.occupy(row, xs, occ, after);
+    }
+}
+
+impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> BlockSink for Kernel<'_, Q, D, CELLS, GENERAL> {
+    const CELLS: usize = CELLS;
+
+    fn occupancy(&self) -> &[u64] {
+        self.planes.occupancy
+    }
+
+    #[inline(always)]
+    fn visit(&mut self, row: &BlockRow, x0: isize, bx: usize, occ: u8) {
+        let sh = self.shared;
+        if !GENERAL && sh.plain && row.outside == 0 && x0 >= 0 {
+            let x0 = x0 as usize;
+            let x1 = if x0 + 1 < sh.n[0] { Some(x0 + 1) } else { sh.part.axes[0].periodic.then_some(0) };
+            if let Some(x1) = x1 {
+                return self.lean(row, [x0, x1], row.index + bx as u64, occ);
+            }
+        }
+        self.general(row, x0, bx, occ);
+    }
+}

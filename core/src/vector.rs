@@ -1,0 +1,117 @@
+//! The few vector operations the model needs, on `[f32; 3]` (the third
+//! component 0 in 2D): dot product, normalisation, and the speed clamp of
+//! M5.5.
+
+#[inline]
+pub(crate) fn dot(a: [f32; 3], b: [f32; 3]) -> f32 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// `v / |v|`, or `None` where the length is zero or not finite.
+pub(crate) fn normalise(v: [f32; 3]) -> Option<[f32; 3]> {
+    let len = libm::sqrtf(dot(v, v));
+    (len.is_finite() && len > 1e-6).then(|| [v[0] / len, v[1] / len, v[2] / len])
+}
+
+/// M5.5: scales `v` back to `|v| = limit` if it is longer, returning the
+/// squared length it had (`None` if nothing changed). `limit` is 1 for
+/// velocities in cells per step, `SCALE` for velocities in quanta.
+///
+/// A velocity that overflowed `f32` (a force of 1e30 over a mass of 1e-30)
+/// keeps its direction: infinite components become unit ones and finite
+/// ones vanish beside them; a component left undefined (`inf - inf`) counts
+/// as zero. The squared length is then reported as infinite.
+#[inline]
+pub(crate) fn clamp(v: &mut [f32; 3], limit: f32) -> Option<f32> {
+    let s2 = dot(*v, *v);
+    if s2 <= limit * limit {
+        return None;
+    }
+    clamp_long(v, s2, limit)
+}
+
+/// The part of [`clamp`] that runs only when it clamps.
+#[cold]
+fn clamp_long(v: &mut [f32; 3], s2: f32, limit: f32) -> Option<f32> {
+    if !s2.is_finite() {
+        // In units of the limit, so that "short enough" means length <= 1.
+        for c in v.iter_mut() {
+            *c /= limit;
+        }
+        let big = v.iter().filter(|c| !c.is_nan()).fold(0.0f32, |b, c| b.max(c.abs()));
+        for c in v.iter_mut() {
+            *c = if c.is_nan() || big == 0.0 {
+                0.0
+            } else if big.is_infinite() {
+                if c.is_infinite() { c.signum() } else { 0.0 }
+            } else if big > 1.0 {
+                *c / big
+            } else {
+                // Only a NaN made the length undefined; what is left is
+                // already short enough and keeps its size.
+                *c
+            };
+        }
+        let _ = clamp(v, 1.0);
+        for c in v.iter_mut() {
+            *c *= limit;
+        }
+        return Some(f32::INFINITY);
+    }
+    let scale = limit / libm::sqrtf(s2);
+    for c in v.iter_mut() {
+        *c *= scale;
+    }
+    Some(s2)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn clamp_survives_overflow() {
+        // Expectation: a finite unit vector along the overflowing direction,
+        // zero where the direction is undefined, and an infinite length.
+        for (v, want) in [
+            ([f32::INFINITY, 1.0, 0.0], [1.0, 0.0, 0.0]),
+            ([f32::NEG_INFINITY, f32::INFINITY, 0.0], [-core::f32::consts::FRAC_1_SQRT_2, core::f32::consts::FRAC_1_SQRT_2, 0.0]),
+            ([3e38, 3e38, 0.0], [core::f32::consts::FRAC_1_SQRT_2, core::f32::consts::FRAC_1_SQRT_2, 0.0]),
+            ([f32::NAN, 0.0, 2.0], [0.0, 0.0, 1.0]),
+            ([f32::NAN, 0.25, 0.0], [0.0, 0.25, 0.0]),
+            ([f32::NAN, f32::NAN, f32::NAN], [0.0, 0.0, 0.0]),
+        ] {
+            let mut u = v;
+            assert_eq!(clamp(&mut u, 1.0), Some(f32::INFINITY), "{v:?}");
+            for k in 0..3 {
+                assert!((u[k] - want[k]).abs() < 1e-6, "{v:?} -> {u:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn clamp_in_quanta_keeps_short_components_beside_a_nan() {
+        // Expect: with limit 127, a NaN next to a short component leaves
+        // the component as it is (not scaled by the limit).
+        let mut v = [f32::NAN, 0.0, 0.127];
+        assert_eq!(clamp(&mut v, 127.0), Some(f32::INFINITY));
+        assert_eq!(v, [0.0, 0.0, 0.127]);
+        let mut v = [f32::INFINITY, 5.0, 0.0];
+        assert_eq!(clamp(&mut v, 127.0), Some(f32::INFINITY));
+        assert_eq!(v, [127.0, 0.0, 0.0]);
+    }
+
+    #[test]
+    fn clamp_reports_the_squared_length() {
+        let mut v = [0.6, 0.8, 0.0];
+        assert_eq!(clamp(&mut v, 1.0), None);
+        let mut v = [2.0, 0.0, 0.0];
+        assert_eq!(clamp(&mut v, 1.0), Some(4.0));
+        assert_eq!(v, [1.0, 0.0, 0.0]);
+        // In quanta the result may sit an ulp above the limit; storage
+        // clamps each component to the limit anyway.
+        let mut v = [0.0, 300.0, 0.0];
+        assert_eq!(clamp(&mut v, 127.0), Some(90_000.0));
+        assert!(v[0] == 0.0 && v[2] == 0.0 && (v[1] - 127.0).abs() <= 127.0 * f32::EPSILON, "{v:?}");
+    }
+}
