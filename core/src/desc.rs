@@ -208,6 +208,13 @@ pub(crate) struct Layout {
     /// 64-bit words per x-row of a bit plane (rows are padded to whole words).
     pub row_words: usize,
     pub occupancy: Plane,
+    /// One byte per row `y + ny z`: 0 where the row holds no particle for
+    /// sure, 1 where it may hold one (the step skips rows of 0, M3).
+    pub rows: Plane,
+    /// Per row, `summary_words` words with one bit per occupancy word: 0
+    /// where that word holds no particle for sure (the step skips it).
+    pub words: Plane,
+    pub summary_words: usize,
     pub obstacle: Plane,
     pub velocity: Plane,
     pub mass_index: Plane,
@@ -292,6 +299,9 @@ impl Layout {
         };
         let mut b = Builder { at: 0 };
         let occupancy = b.plane(bit_plane)?;
+        let rows = b.plane(n[1] * n[2])?;
+        let summary_words = row_words.div_ceil(64);
+        let words = b.plane(summary_words * n[1] * n[2] * 8)?;
         let obstacle = b.plane(if d.obstacles { bit_plane } else { 0 })?;
         let velocity = b.plane(per_cell(dim * q, true)?)?;
         let mass_index = b.plane(per_cell(1, d.per_particle_mass)?)?;
@@ -313,6 +323,9 @@ impl Layout {
             cells,
             row_words,
             occupancy,
+            rows,
+            words,
+            summary_words,
             obstacle,
             velocity,
             mass_index,

@@ -35,11 +35,11 @@ use crate::collision::{block_pairs, collide_pair, pair_holds_two, random_unit, s
 use crate::desc::Description;
 use crate::force::ForceTerms;
 use crate::obstacle::{reflect, surface_at, Surface};
-use crate::partition::{cells_at, resolve, BlockRow, BlockSink, Beyond, Partition};
+use crate::partition::{cells_at, resolve, BlockRow, BlockSink, Beyond, Index, Partition};
 use crate::quant::{Quant, wants_move_f32};
 use crate::rng::{StepKey, Stream};
 use crate::vector::{clamp, dot, normalise};
-use crate::world::{put_bit, Counters, ENERGY_SCALE};
+use crate::world::{mark, put_bit, Counters, ENERGY_SCALE};
 
 /// What every block of a step reads and none writes.
 pub(crate) struct Shared<'a> {
@@ -67,6 +67,8 @@ pub(crate) struct Shared<'a> {
 /// together.
 pub(crate) struct Writable<'a, Q, const D: usize> {
     pub occupancy: &'a mut [u64],
+    pub rows: &'a mut [u8],
+    pub words: &'a mut [u64],
     pub velocity: &'a mut [[Q; D]],
     pub mass_index: &'a mut [u8],
     pub life: &'a mut [u16],
@@ -439,6 +441,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
         }
         for c in cells_of(after & !before) {
             put_bit(self.planes.occupancy, bit(c), true);
+            mark(self.planes.rows, self.planes.words, self.shared.part.summary_words, row.line[c >> 1], xs[c & 1]);
         }
     }
 
@@ -607,8 +610,8 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
 impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> BlockSink for Kernel<'_, Q, D, CELLS, GENERAL> {
     const CELLS: usize = CELLS;
 
-    fn occupancy(&self) -> &[u64] {
-        self.planes.occupancy
+    fn index(&mut self) -> Index<'_> {
+        Index { occupancy: self.planes.occupancy, rows: self.planes.rows, words: self.planes.words }
     }
 
     #[inline(always)]

@@ -80,6 +80,8 @@ pub(crate) struct Partition {
     pub axes: [Axis; 3],
     pub dim: usize,
     row_words: usize,
+    /// Summary words per row: one bit per occupancy word.
+    pub summary_words: usize,
 }
 
 /// One row of blocks of a step's partition: the blocks that share their y
@@ -90,6 +92,9 @@ pub(crate) struct Partition {
 pub(crate) struct BlockRow {
     pub word: [usize; 4],
     pub cell: [usize; 4],
+    /// The domain row `y + ny z` of block row `r`, its index in the row
+    /// flags.
+    pub line: [usize; 4],
     /// The block cells beyond a y or z face (a half block on a face that is
     /// not periodic), as a mask over the block's cells; their `word` and
     /// `cell` are 0 and mean nothing.
@@ -100,12 +105,25 @@ pub(crate) struct BlockRow {
     pub index: u64,
 }
 
+/// What the sweep reads to find the occupied blocks, and the summaries it
+/// keeps exact for the rows it sweeps.
+pub(crate) struct Index<'a> {
+    /// The occupancy plane.
+    pub occupancy: &'a [u64],
+    /// A byte per domain row: 0 where the row holds no particle for sure.
+    pub rows: &'a mut [u8],
+    /// Per domain row, one bit per occupancy word: 0 where the word holds
+    /// no particle for sure.
+    pub words: &'a mut [u64],
+}
+
 /// What the sweep hands each occupied block to.
 pub(crate) trait BlockSink {
     /// Cells of a block: 4 in 2D, 8 in 3D.
     const CELLS: usize;
-    /// The occupancy plane, read between visits.
-    fn occupancy(&self) -> &[u64];
+    /// The planes the sweep reads and the summaries it keeps, read between
+    /// visits.
+    fn index(&mut self) -> Index<'_>;
     /// Processes block `bx` of `row`, whose lowest corner has x `x0` and
     /// whose cells holding a particle are the set bits of `occ` (bit `c` for
     /// cell `c`, never a cell beyond a face).
@@ -144,7 +162,7 @@ impl Partition {
                 Axis { n, first: -1, blocks: n / 2 + 1, periodic }
             }
         };
-        Partition { offset, axes: [axis(0), axis(1), axis(2)], dim, row_words: layout.row_words }
+        Partition { offset, axes: [axis(0), axis(1), axis(2)], dim, row_words: layout.row_words, summary_words: layout.summary_words }
     }
 
     /// Blocks in the grid, occupied or not.
@@ -184,16 +202,32 @@ impl Partition {
     /// Visits every block holding a particle, forward (x fastest) or in
     /// exactly the reverse order. Blocks are independent (M3), so both orders
     /// leave the same world; the tests check it.
-    pub fn sweep<S: BlockSink>(&self, sink: &mut S, reverse: bool) {
+    ///
+    /// Rows of blocks whose domain rows are all flagged empty are skipped,
+    /// four at a time where eight rows of flags read as one word are zero;
+    /// a row of blocks that is swept leaves its rows' flags exact.
+    ///
+    /// With `skip` false every row and word is swept, whatever the
+    /// summaries say (the tests' reference).
+    pub fn sweep<S: BlockSink>(&self, sink: &mut S, reverse: bool, skip: bool) {
         let [ax, ay, az] = self.axes;
         let layers = if self.dim == 3 { 2 } else { 1 };
-        for i in 0..ay.blocks * az.blocks {
-            let i = if reverse { ay.blocks * az.blocks - 1 - i } else { i };
+        let total = ay.blocks * az.blocks;
+        let mut j = 0;
+        while j < total {
+            let i = if reverse { total - 1 - j } else { j };
             let (by, bz) = (i % ay.blocks, i / ay.blocks);
+            let run = if skip { self.empty_run(sink.index().rows, by, bz, reverse) } else { 0 };
+            if run > 0 {
+                j += run;
+                continue;
+            }
+            j += 1;
             let origin = [ay.first + 2 * by as isize, az.first + 2 * bz as isize];
             let (ys, y_out) = self.axis_pair(1, origin[0]);
             let (zs, z_out) = self.axis_pair(2, origin[1]);
-            let mut row = BlockRow { word: [0; 4], cell: [0; 4], outside: 0, origin, index: (i * ax.blocks) as u64 };
+            let mut row = BlockRow { word: [0; 4], cell: [0; 4], line: [0; 4], outside: 0, origin, index: (i * ax.blocks) as u64 };
+            let mut flagged = false;
             for dz in 0..layers {
                 for dy in 0..2 {
                     let r = dy + 2 * dz;
@@ -202,12 +236,46 @@ impl Partition {
                         continue;
                     }
                     let line = ys[dy] + ay.n * zs[dz];
+                    row.line[r] = line;
                     row.word[r] = line * self.row_words;
                     row.cell[r] = line * ax.n;
+                    flagged |= sink.index().rows[line] != 0;
                 }
             }
-            self.sweep_row(sink, &row, reverse);
+            if flagged || !skip {
+                self.sweep_row(sink, &row, reverse, skip);
+            }
         }
+    }
+
+    /// How many rows of blocks from (`by`, `bz`) on (back from it in
+    /// reverse), all in one layer of blocks and away from the faces, hold
+    /// no particle for sure: a multiple of four, their rows read eight flags
+    /// at a time, at most 32.
+    #[inline]
+    fn empty_run(&self, rows: &[u8], by: usize, bz: usize, reverse: bool) -> usize {
+        let [_, ay, az] = self.axes;
+        let (zs, z_out) = self.axis_pair(2, az.first + 2 * bz as isize);
+        let layers = if self.dim == 3 { 2 } else { 1 };
+        let mut run = 0;
+        while run < 32 {
+            // The four rows of blocks from `low` to `low + 3`.
+            let low = if reverse { by.checked_sub(run + 3) } else { Some(by + run).filter(|&b| b + 4 <= ay.blocks) };
+            let Some(low) = low else { break };
+            let y = ay.first + 2 * low as isize;
+            if y < 0 || y as usize + 8 > ay.n {
+                break;
+            }
+            let empty = (0..layers).all(|dz| {
+                let at = zs[dz] * ay.n + y as usize;
+                z_out >> dz & 1 != 0 || rows[at..at + 8] == [0; 8]
+            });
+            if !empty {
+                break;
+            }
+            run += 4;
+        }
+        run
     }
 
     /// Word `w` of each domain row of a row of blocks (0 for a row beyond
@@ -223,10 +291,10 @@ impl Partition {
         m
     }
 
-    fn sweep_row<S: BlockSink>(&self, sink: &mut S, row: &BlockRow, reverse: bool) {
+    fn sweep_row<S: BlockSink>(&self, sink: &mut S, row: &BlockRow, reverse: bool, skip: bool) {
         match S::CELLS {
-            4 => self.sweep_row_of::<S, 2>(sink, row, reverse),
-            _ => self.sweep_row_of::<S, 4>(sink, row, reverse),
+            4 => self.sweep_row_of::<S, 2>(sink, row, reverse, skip),
+            _ => self.sweep_row_of::<S, 4>(sink, row, reverse, skip),
         }
     }
 
@@ -236,9 +304,11 @@ impl Partition {
     /// Blocks only change their own cells, so a word read before a block
     /// was visited still holds the right bits for every later block.
     #[inline(always)]
-    fn sweep_row_of<S: BlockSink, const ROWS: usize>(&self, sink: &mut S, row: &BlockRow, reverse: bool) {
+    fn sweep_row_of<S: BlockSink, const ROWS: usize>(&self, sink: &mut S, row: &BlockRow, reverse: bool, skip: bool) {
         let ax = self.axes[0];
         let words = self.row_words;
+        let sw = self.summary_words;
+        let inside = |r: usize| row.outside >> (2 * r) & 1 == 0;
         // The block's cells 2r, 2r + 1 from bits b, b + 1 of row word r.
         let block = |m: &[u64; ROWS], b: usize| {
             let mut bits = 0u8;
@@ -247,59 +317,99 @@ impl Partition {
             }
             bits
         };
+        // Summary word k of the row's domain rows, OR-ed.
+        let summary = |idx: &Index<'_>, k: usize| (0..ROWS).filter(|&r| inside(r)).fold(0, |s, r| s | idx.words[row.line[r] * sw + k]);
         // Offset 1, not periodic: the half block (-1, 0) has block index 0,
         // its cell 1 in bit 0 of each row, and the pairs after it start at
         // index 1.
         let half = self.offset == 1 && !ax.periodic;
         let half_block = |sink: &mut S| {
-            let first = Self::words::<ROWS>(sink.occupancy(), row, 0).map(|m| (m & 1) << 1);
+            let first = Self::words::<ROWS>(sink.index().occupancy, row, 0).map(|m| (m & 1) << 1);
             let bits = block(&first, 0);
             if bits != 0 {
                 sink.visit(row, -1, 0, bits);
             }
         };
+        // The rows' flags start cleared; they are set again below for every
+        // row a word with a particle is seen in, and by the blocks for every
+        // row a particle moves into.
+        for r in (0..ROWS).filter(|&r| inside(r)) {
+            sink.index().rows[row.line[r]] = 0;
+        }
+        let mut seen = [0u64; ROWS];
         if half && !reverse {
             half_block(sink);
         }
         // Cell nx (one past the end) is cell 0 when periodic: read it before
         // any block of the row is visited (only the wrapping block holds it).
         let wrap = if self.offset == 1 && ax.periodic {
-            Self::words::<ROWS>(sink.occupancy(), row, 0).map(|m| m & 1)
+            Self::words::<ROWS>(sink.index().occupancy, row, 0).map(|m| m & 1)
         } else {
             [0; ROWS]
         };
         let last = (ax.n - 1) / 64;
-        for j in 0..words {
-            let w = if reverse { words - 1 - j } else { j };
-            let occ = sink.occupancy();
-            let mut m = Self::words::<ROWS>(occ, row, w);
+        for jk in 0..sw {
+            let k = if reverse { sw - 1 - jk } else { jk };
+            // The words to sweep: those that may hold a particle, and at
+            // offset 1 those before them (the pair 64w + 63, 64w + 64 lies
+            // across two words, and the last word's pair wraps to cell 0).
+            let mut todo = summary(&sink.index(), k);
+            if !skip {
+                // Every word of the row.
+                let count = (words - 64 * k).min(64);
+                todo = u64::MAX >> (64 - count);
+            }
             if self.offset == 1 {
-                // Pairs (2i+1, 2i+2): shift so bit b is cell 64 w + b + 1.
-                let next = if w + 1 < words { Self::words::<ROWS>(occ, row, w + 1) } else { [0; ROWS] };
-                for r in 0..ROWS {
-                    m[r] = m[r] >> 1 | next[r] << 63;
-                    if w == last {
-                        m[r] |= wrap[r] << ((ax.n - 1) % 64);
-                    }
+                let next = if k + 1 < sw { summary(&sink.index(), k + 1) & 1 } else { 0 };
+                todo |= todo >> 1 | next << 63;
+                if last >> 6 == k && wrap.iter().any(|&b| b != 0) {
+                    todo |= 1 << (last & 63);
                 }
             }
-            let any = m.iter().fold(0, |a, &x| a | x);
-            // Pair (2i, 2i+1) of the (shifted) words: bit 2i of the fold.
-            let mut bits = (any | any >> 1) & EVEN;
-            while bits != 0 {
-                let b = if reverse { 63 - bits.leading_zeros() } else { bits.trailing_zeros() } as usize;
-                bits &= !(1u64 << b);
-                let pair = 32 * w + b / 2;
-                let occ = block(&m, b);
-                if self.offset == 0 {
-                    sink.visit(row, 2 * pair as isize, pair, occ);
-                } else {
-                    sink.visit(row, 2 * pair as isize + 1, pair + usize::from(half), occ);
+            while todo != 0 {
+                let b = if reverse { 63 - todo.leading_zeros() } else { todo.trailing_zeros() } as usize;
+                todo &= !(1u64 << b);
+                let w = 64 * k + b;
+                let idx = sink.index();
+                let mut m = Self::words::<ROWS>(idx.occupancy, row, w);
+                for r in (0..ROWS).filter(|&r| inside(r)) {
+                    seen[r] |= m[r];
+                    if m[r] == 0 {
+                        // Swept and empty: the summary says so from now on.
+                        idx.words[row.line[r] * sw + k] &= !(1u64 << b);
+                    }
+                }
+                if self.offset == 1 {
+                    // Pairs (2i+1, 2i+2): shift so bit b is cell 64 w + b + 1.
+                    let next = if w + 1 < words { Self::words::<ROWS>(idx.occupancy, row, w + 1) } else { [0; ROWS] };
+                    for r in 0..ROWS {
+                        m[r] = m[r] >> 1 | next[r] << 63;
+                        if w == last {
+                            m[r] |= wrap[r] << ((ax.n - 1) % 64);
+                        }
+                    }
+                }
+                let any = m.iter().fold(0, |a, &x| a | x);
+                // Pair (2i, 2i+1) of the (shifted) words: bit 2i of the fold.
+                let mut bits = (any | any >> 1) & EVEN;
+                while bits != 0 {
+                    let b = if reverse { 63 - bits.leading_zeros() } else { bits.trailing_zeros() } as usize;
+                    bits &= !(1u64 << b);
+                    let pair = 32 * w + b / 2;
+                    let occ = block(&m, b);
+                    if self.offset == 0 {
+                        sink.visit(row, 2 * pair as isize, pair, occ);
+                    } else {
+                        sink.visit(row, 2 * pair as isize + 1, pair + usize::from(half), occ);
+                    }
                 }
             }
         }
         if half && reverse {
             half_block(sink);
+        }
+        for r in (0..ROWS).filter(|&r| inside(r) && seen[r] != 0) {
+            sink.index().rows[row.line[r]] = 1;
         }
     }
 }

@@ -210,6 +210,8 @@ pub(crate) use with_quant;
 /// Mutable views of every plane, borrowed together.
 pub(crate) struct Planes<'a, Q> {
     pub occupancy: &'a mut [u64],
+    pub rows: &'a mut [u8],
+    pub words: &'a mut [u64],
     pub obstacle: &'a mut [u64],
     pub velocity: &'a mut [Q],
     pub mass_index: &'a mut [u8],
@@ -228,6 +230,20 @@ pub(crate) struct Site {
     pub cell: usize,
     /// Bit index in a bit plane (rows padded to whole words).
     pub bit: usize,
+    /// The cell's row `y + ny z`, its index in the row flags.
+    pub row: usize,
+    /// The cell's x.
+    pub x: usize,
+}
+
+/// Notes that cell `x` of row `row` now holds a particle: sets the row's
+/// flag and its summary bit for the occupancy word holding the cell, so the
+/// step does not skip them (M3). `summary_words` words per row.
+#[inline]
+pub(crate) fn mark(rows: &mut [u8], words: &mut [u64], summary_words: usize, row: usize, x: usize) {
+    rows[row] = 1;
+    let w = x >> 6;
+    words[row * summary_words + (w >> 6)] |= 1 << (w & 63);
 }
 
 #[inline]
@@ -248,7 +264,7 @@ impl Layout {
     #[inline]
     pub(crate) fn site(&self, x: usize, y: usize, z: usize) -> Site {
         let row = y + self.n[1] * z;
-        Site { cell: x + self.n[0] * row, bit: row * self.row_words * 64 + x }
+        Site { cell: x + self.n[0] * row, bit: row * self.row_words * 64 + x, row, x }
     }
 }
 
@@ -374,6 +390,8 @@ impl World {
         };
         let planes = Planes {
             occupancy: view(take(l.occupancy)),
+            rows: take(l.rows),
+            words: view(take(l.words)),
             obstacle: view(take(l.obstacle)),
             velocity: view(take(l.velocity)),
             mass_index: take(l.mass_index),
@@ -516,11 +534,13 @@ impl World {
     /// stochastically from `stream` when one is given (M1), else to nearest.
     pub(crate) fn place(&mut self, s: Site, v: [f32; 3], class: u8, life: u16, stream: Option<&mut crate::rng::Stream>) {
         let d = self.dim();
+        let summary_words = self.layout().summary_words;
         let per_mass = self.head.desc.per_particle_mass;
         let lifetimes = self.head.desc.lifetimes;
         with_quant!(self.head.desc.quantization, Q => {
             let (_, p) = self.planes::<Q>();
             put_bit(p.occupancy, s.bit, true);
+            mark(p.rows, p.words, summary_words, s.row, s.x);
             let r = stream.map(|rng| rng.next_u64());
             for k in 0..d {
                 p.velocity[s.cell * d + k] = match r {

@@ -1,4 +1,5 @@
-//! The paper's four scenes, timed: `cargo bench -p mpca-tests`.
+//! The paper's four scenes and the size cases, timed: `cargo bench -p
+//! mpca-tests`.
 //!
 //! For each scene it builds the world, runs the paper's step count several
 //! times (set `MPCA_BENCH_RUNS`, default 5) and prints the median wall time
@@ -11,55 +12,77 @@
 
 use std::time::Instant;
 
-use mpca_tests::scenes::{build, paper_scenes};
+use mpca_tests::scenes::{build, paper_scenes, size_scenes, Scene};
+
+/// One scene's timing: the median and spread of `runs` runs, and what the
+/// last run did.
+struct Timing {
+    times: Vec<f64>,
+    processed: u64,
+    total: u64,
+    particles: u64,
+    bytes_per_cell: f64,
+}
+
+fn time(scene: &Scene, runs: usize, memory: &mut Vec<u8>) -> Timing {
+    let mut t = Timing { times: Vec::with_capacity(runs), processed: 0, total: 0, particles: 0, bytes_per_cell: 0.0 };
+    for _ in 0..runs {
+        let world = build(scene, memory).expect("scene builds");
+        let (mut p, mut all) = (0u64, 0u64);
+        let start = Instant::now();
+        for _ in 0..scene.steps {
+            world.step(1);
+            let (done, skipped) = world.last_step_blocks();
+            p += done;
+            all += done + skipped;
+        }
+        t.times.push(start.elapsed().as_secs_f64());
+        (t.processed, t.total) = (p, all);
+        t.particles = world.particle_count();
+        t.bytes_per_cell = world.bytes_per_cell();
+    }
+    t.times.sort_by(f64::total_cmp);
+    t
+}
 
 fn main() {
     let runs: usize = std::env::var("MPCA_BENCH_RUNS").ok().and_then(|s| s.parse().ok()).unwrap_or(5).max(1);
-    println!("mpca {} — paper scenes, median of {runs} runs", env!("CARGO_PKG_VERSION"));
+    println!("mpca {} — paper scenes and size cases, median of {runs} runs", env!("CARGO_PKG_VERSION"));
     println!(
         "{:<12} {:>4} {:>9} {:>9} {:>6} {:>11} {:>15} {:>10} {:>9} {:>7} {:>12} {:>10}",
         "scene", "sec", "cells", "particles", "steps", "median_ms", "min..max_ms", "ns/block", "skipped", "B/cell", "paper_s", "blocks"
     );
     let only = std::env::var("MPCA_BENCH_SCENE").ok();
     let mut memory = Vec::new();
-    for scene in paper_scenes().into_iter().filter(|s| only.as_deref().is_none_or(|n| n == s.name)) {
-        let mut times = Vec::with_capacity(runs);
-        let (mut processed, mut total) = (0u64, 0u64);
-        let mut particles = 0;
-        let mut bytes_per_cell = 0.0;
-        for _ in 0..runs {
-            let world = build(&scene, &mut memory).expect("scene builds");
-            let (mut p, mut t) = (0u64, 0u64);
-            let start = Instant::now();
-            for _ in 0..scene.steps {
-                world.step(1);
-                let (done, skipped) = world.last_step_blocks();
-                p += done;
-                t += done + skipped;
-            }
-            times.push(start.elapsed().as_secs_f64());
-            (processed, total) = (p, t);
-            particles = world.particle_count();
-            bytes_per_cell = world.bytes_per_cell();
-        }
-        times.sort_by(f64::total_cmp);
-        let median = times[runs / 2];
+    let mut per_step = Vec::new();
+    let scenes = paper_scenes().into_iter().chain(size_scenes());
+    for scene in scenes.filter(|s| only.as_deref().is_none_or(|n| n == s.name)) {
+        let t = time(&scene, runs, &mut memory);
+        let median = t.times[runs / 2];
         let cells: u64 = scene.desc.size[..scene.desc.dim as usize].iter().map(|&s| u64::from(s)).product();
         println!(
             "{:<12} {:>4} {:>9} {:>9} {:>6} {:>11.2} {:>7.2}..{:<7.2} {:>10.1} {:>8.1}% {:>7.3} {:>12.0} {:>10}",
             scene.name,
             scene.section,
             cells,
-            particles,
+            t.particles,
             scene.steps,
             median * 1e3,
-            times[0] * 1e3,
-            times[runs - 1] * 1e3,
-            median * 1e9 / processed.max(1) as f64,
-            100.0 * (total - processed) as f64 / total.max(1) as f64,
-            bytes_per_cell,
+            t.times[0] * 1e3,
+            t.times[runs - 1] * 1e3,
+            median * 1e9 / t.processed.max(1) as f64,
+            100.0 * (t.total - t.processed) as f64 / t.total.max(1) as f64,
+            t.bytes_per_cell,
             scene.paper_seconds,
-            processed,
+            t.processed,
         );
+        per_step.push((scene.name, median / scene.steps as f64));
+    }
+    // The size cases against the 128^2 gas, from the same run.
+    if let Some(&(_, base)) = per_step.iter().find(|(n, _)| *n == "gas-128") {
+        println!("\nper step, against gas-128 ({:.1} us):", base * 1e6);
+        for (name, t) in per_step.iter().filter(|(n, _)| n.starts_with("gas-") || n.starts_with("empty-")) {
+            println!("{name:<12} {:>10.1} us {:>8.3}x", t * 1e6, t / base);
+        }
     }
 }

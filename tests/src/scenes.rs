@@ -41,8 +41,13 @@ pub fn aggregation() -> Scene {
 }
 
 fn fill_aggregation(w: &mut World) -> Result<(), Error> {
-    let mut rng = setup_rng(w);
     let [nx, ny, _] = w.description().size;
+    fill_gas(w, nx, ny)
+}
+
+/// The aggregation scene's gas in cells `[0, nx) x [0, ny)`.
+fn fill_gas(w: &mut World, nx: u32, ny: u32) -> Result<(), Error> {
+    let mut rng = setup_rng(w);
     for y in 0..ny {
         for x in 0..nx {
             if unit(&mut rng) < 0.3 {
@@ -134,6 +139,22 @@ fn fill_water(w: &mut World) -> Result<(), Error> {
         lifetime: 0,
     })?;
     Ok(())
+}
+
+/// The benchmark's size cases (issue 8): the aggregation gas in the
+/// 128 x 128 corner of a periodic world of 128^2, 1024^2 and 4096^2 cells,
+/// and an empty 4096^2 world, 200 steps each: what a step costs should
+/// follow the particles, not the world's size.
+pub fn size_scenes() -> [Scene; 4] {
+    let gas = |name, n| {
+        let mut desc = Description::new_2d(n, n);
+        desc.restitution = 0.5;
+        desc.seed = 41;
+        Scene { name, section: "-", desc, steps: 200, paper_seconds: f64::NAN, setup: |w| fill_gas(w, 128, 128) }
+    };
+    let mut empty = gas("empty-4096", 4096);
+    empty.setup = |_| Ok(());
+    [gas("gas-128", 128), gas("gas-1024", 1024), gas("gas-4096", 4096), empty]
 }
 
 /// All four, in the paper's order.
