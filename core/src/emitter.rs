@@ -10,7 +10,8 @@ use crate::collision::random_unit;
 use crate::desc::finite;
 use crate::rng::{StepKey, Stream};
 use crate::vector::{clamp, dot};
-use crate::world::{Plain, World};
+use crate::layout::Plain;
+use crate::world::World;
 use crate::Error;
 
 /// An emitter as the caller describes it.
@@ -40,7 +41,7 @@ pub struct Emitter {
 #[repr(C)]
 pub(crate) struct Slot {
     pub emitter: Emitter,
-    pub class: u32,
+    pub mass_index: u32,
 }
 
 // SAFETY: u32 and f32 fields only, no padding, every bit pattern valid.
@@ -74,9 +75,9 @@ impl World {
         if used >= self.layout().emitters.len / core::mem::size_of::<Slot>() {
             return Err(Error::EmitterTableFull);
         }
-        let class = u32::from(self.mass_class(e.mass)?);
+        let mass_index = u32::from(self.mass_index_of(e.mass)?);
         let (head, p) = self.planes::<u8>();
-        p.emitters[used] = Slot { emitter: e, class };
+        p.emitters[used] = Slot { emitter: e, mass_index };
         head.emitters += 1;
         Ok(used)
     }
@@ -127,7 +128,7 @@ impl World {
                 if take {
                     need -= 1;
                     let v = spread_velocity(&e, dim, &mut rng);
-                    w.place(s, v, slot.class as u8, e.lifetime as u16, Some(&mut rng));
+                    w.place(s, v, slot.mass_index as u8, e.lifetime as u16, Some(&mut rng));
                 }
             };
             each_site(&l, &e, |s| chosen(self, s));
@@ -138,7 +139,7 @@ impl World {
 }
 
 /// Calls `f` with every site of the emitter's region.
-fn each_site(l: &crate::desc::Layout, e: &Emitter, mut f: impl FnMut(crate::world::Site)) {
+fn each_site(l: &crate::layout::Layout, e: &Emitter, mut f: impl FnMut(crate::layout::Site)) {
     for z in e.min[2] as usize..e.max[2] as usize {
         for y in e.min[1] as usize..e.max[1] as usize {
             for x in e.min[0] as usize..e.max[0] as usize {

@@ -39,7 +39,8 @@ use crate::partition::{cells_at, resolve, BlockRow, BlockSink, Beyond, Index, Pa
 use crate::quant::{Quant, wants_move_f32};
 use crate::rng::{StepKey, Stream};
 use crate::vector::{clamp, dot, normalise};
-use crate::world::{mark, put_bit, Counters, ENERGY_SCALE};
+use crate::layout::{mark, put_bit};
+use crate::world::{Counters, ENERGY_SCALE};
 
 /// What every block of a step reads and none writes.
 pub(crate) struct Shared<'a> {
@@ -521,12 +522,12 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
 
         let mut b = self.load(row, xs, occ);
         let mut mass = [desc.mass; CELLS];
-        let mut class = [0u8; CELLS];
+        let mut mass_index = [0u8; CELLS];
         let mut life = [0u16; CELLS];
         for c in cells_of(occ) {
             if desc.per_particle_mass {
-                class[c] = self.planes.mass_index[cell(c)];
-                mass[c] = sh.mass_table[usize::from(class[c])];
+                mass_index[c] = self.planes.mass_index[cell(c)];
+                mass[c] = sh.mass_table[usize::from(mass_index[c])];
             }
             if desc.lifetimes {
                 life[c] = self.planes.life[cell(c)];
@@ -596,7 +597,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
                     self.store(&b, c, to, &mut rng);
                 }
                 if desc.per_particle_mass && t != c {
-                    self.planes.mass_index[to] = class[c];
+                    self.planes.mass_index[to] = mass_index[c];
                 }
                 if desc.lifetimes {
                     self.planes.life[to] = life[c].saturating_sub(1);

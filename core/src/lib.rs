@@ -40,15 +40,19 @@
 pub mod assign;
 mod collision;
 mod desc;
+mod edit;
 mod emitter;
 mod error;
 mod force;
+mod hash;
 mod kernel;
+mod layout;
 mod obstacle;
 #[cfg(feature = "alloc")]
 mod owned;
 mod partition;
 mod quant;
+mod query;
 pub mod rng;
 mod step;
 mod vector;
@@ -62,7 +66,8 @@ pub use obstacle::{Shape, Surface};
 #[cfg(feature = "alloc")]
 pub use owned::WorldBox;
 pub use step::Order;
-pub use world::{world_bytes, Cell, Particle, Particles, Stats, World, WORLD_ALIGN};
+pub use query::{Cell, Particle, Particles, Stats};
+pub use world::{world_bytes, World, WORLD_ALIGN};
 
 /// The README's Rust example, compiled and run as a doctest so it stays true.
 #[cfg(doctest)]

@@ -12,7 +12,8 @@
 use crate::desc::{finite, restitution};
 use crate::partition::{resolve, Beyond};
 use crate::vector::{dot, normalise};
-use crate::world::{put_bit, Plain, World};
+use crate::layout::{put_bit, Plain};
+use crate::world::World;
 use crate::Error;
 
 /// One obstacle surface cell.

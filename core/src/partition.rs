@@ -16,7 +16,8 @@
 //! occupancy rows of a row of blocks are OR-ed together, folded pairwise, and
 //! only the set bits of the fold are visited.
 
-use crate::desc::{Boundary, Layout};
+use crate::desc::Boundary;
+use crate::layout::Layout;
 use crate::vector::normalise;
 
 /// Where a cell coordinate lands under the boundary rules of M4.

@@ -10,8 +10,28 @@
 use crate::desc::Drift;
 use crate::rng::Stream;
 
+/// Dispatches on the world's velocity storage type.
+macro_rules! with_quant {
+    ($q:expr, $t:ident => $body:expr) => {
+        match $q {
+            $crate::desc::Quantization::Bits8 => {
+                type $t = i8;
+                $body
+            }
+            #[cfg(feature = "q16")]
+            $crate::desc::Quantization::Bits16 => {
+                type $t = i16;
+                $body
+            }
+            #[cfg(not(feature = "q16"))]
+            $crate::desc::Quantization::Bits16 => unreachable!("refused by Layout::of"),
+        }
+    };
+}
+pub(crate) use with_quant;
+
 /// A stored velocity component type.
-pub(crate) trait Quant: Copy + Default + crate::world::Plain + 'static {
+pub(crate) trait Quant: Copy + Default + crate::layout::Plain + 'static {
     /// Stored steps per unit speed.
     const SCALE: f32;
     fn from_int(q: i32) -> Self;

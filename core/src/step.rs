@@ -7,13 +7,14 @@
 //! are compile-time parameters of [`Kernel`], so a scene pays nothing in its
 //! inner loop for the parts it does not use.
 
-use crate::desc::Layout;
+use crate::layout::Layout;
 use crate::force::ForceTerms;
 use crate::kernel::{Kernel, Shared, Writable};
 use crate::partition::Partition;
 use crate::quant::Quant;
 use crate::rng::StepKey;
-use crate::world::{groups, Counters, Planes, World};
+use crate::layout::{groups, Planes};
+use crate::world::{Counters, World};
 
 /// The block order of a step. Blocks are independent (M3, M8); the reverse
 /// order exists so tests can show that the result does not depend on it.
@@ -65,7 +66,7 @@ impl World {
 
     fn step_routed(&mut self, route: Route) {
         self.emit();
-        crate::world::with_quant!(self.head.desc.quantization, Q => {
+        crate::quant::with_quant!(self.head.desc.quantization, Q => {
             match self.head.desc.dim {
                 #[cfg(feature = "dim3")]
                 3 => with_force::<Q, 3, 8>(self, route),

@@ -1,0 +1,287 @@
+//! Where everything of a world lies in its memory: the plan of planes a
+//! description gives ([`Layout`], checked in full before a byte is written),
+//! the views of those planes the step and the edits borrow together
+//! ([`Planes`]), where a cell lives in them ([`Site`]), and the bit and
+//! summary helpers of the bit planes.
+
+use core::mem::{align_of, size_of};
+
+use crate::desc::{finite, mass, restitution, Boundary, Description, Quantization};
+use crate::emitter::Slot;
+use crate::obstacle::Surface;
+use crate::Error;
+
+/// Marks plain data that any bit pattern makes valid, so planes of it can be
+/// viewed in the world's bytes.
+///
+/// # Safety
+/// Implementors are `Copy`, have no padding that matters and no invalid bit
+/// patterns.
+pub(crate) unsafe trait Plain: Copy {}
+// SAFETY: primitive integers and floats accept every bit pattern.
+unsafe impl Plain for u8 {}
+unsafe impl Plain for i8 {}
+unsafe impl Plain for u16 {}
+unsafe impl Plain for i16 {}
+unsafe impl Plain for u64 {}
+unsafe impl Plain for f32 {}
+// SAFETY: an array of plain values is plain: no padding between elements,
+// and every element accepts every bit pattern.
+unsafe impl<T: Plain, const N: usize> Plain for [T; N] {}
+
+/// Views a plane of `T` as whole groups of `N` (a cell's `N` velocity
+/// components, say); a partial group at the end is left out.
+#[inline]
+pub(crate) fn groups<T: Plain, const N: usize>(plane: &mut [T]) -> &mut [[T; N]] {
+    const { assert!(N > 0) };
+    // SAFETY: `[T; N]` has the alignment of `T` and the size of N of them,
+    // the length is rounded down to whole groups, any bit pattern is a valid
+    // `[T; N]` (Plain), and the borrow of `plane` is carried over.
+    unsafe { core::slice::from_raw_parts_mut(plane.as_mut_ptr().cast::<[T; N]>(), plane.len() / N) }
+}
+
+/// Views `bytes` as a slice of `T`. Planes start 8-byte aligned by
+/// construction of [`Layout`] and the header's alignment.
+#[inline]
+pub(crate) fn view<T: Plain>(bytes: &mut [u8]) -> &mut [T] {
+    debug_assert_eq!(bytes.as_ptr() as usize % align_of::<T>(), 0);
+    // SAFETY: the pointer is aligned for T (see above), the length is rounded
+    // down to whole T, T accepts every bit pattern, and the borrow of `bytes`
+    // is carried over to the result.
+    unsafe { core::slice::from_raw_parts_mut(bytes.as_mut_ptr().cast::<T>(), bytes.len() / size_of::<T>()) }
+}
+
+/// Read-only twin of [`view`].
+#[inline]
+pub(crate) fn view_ref<T: Plain>(bytes: &[u8]) -> &[T] {
+    debug_assert_eq!(bytes.as_ptr() as usize % align_of::<T>(), 0);
+    // SAFETY: as in `view`.
+    unsafe { core::slice::from_raw_parts(bytes.as_ptr().cast::<T>(), bytes.len() / size_of::<T>()) }
+}
+
+/// Where one plane lies in the world's memory, in bytes from its start.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(crate) struct Plane {
+    pub off: usize,
+    pub len: usize,
+}
+
+/// The memory plan of a world. Every plane starts 8-byte aligned; planes a
+/// scene does not use have length 0 (M9).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Layout {
+    /// Cells per axis, 1 for the unused third axis of 2D.
+    pub n: [usize; 3],
+    pub cells: usize,
+    /// 64-bit words per x-row of a bit plane (rows are padded to whole words).
+    pub row_words: usize,
+    pub occupancy: Plane,
+    /// One byte per row `y + ny z`: 0 where the row holds no particle for
+    /// sure, 1 where it may hold one (the step skips rows of 0, M3).
+    pub rows: Plane,
+    /// Per row, `summary_words` words with one bit per occupancy word: 0
+    /// where that word holds no particle for sure (the step skips it).
+    pub words: Plane,
+    pub summary_words: usize,
+    pub obstacle: Plane,
+    pub velocity: Plane,
+    pub mass_index: Plane,
+    pub life: Plane,
+    pub field: Plane,
+    pub potential: Plane,
+    pub mass_table: Plane,
+    pub surface: Plane,
+    pub emitters: Plane,
+    pub total: usize,
+}
+
+impl Layout {
+    /// Validates `d` and plans its memory. Every size computation is checked,
+    /// so a description whose byte count would overflow is refused.
+    pub fn of(d: &Description) -> Result<Layout, Error> {
+        let dim = d.dim as usize;
+        if dim != 2 && dim != 3 {
+            return Err(Error::BadDimension);
+        }
+        if dim == 3 && !cfg!(feature = "dim3") {
+            return Err(Error::Dim3Disabled);
+        }
+        let mut n = [1usize; 3];
+        for k in 0..dim {
+            let s = d.size[k];
+            if s == 0 {
+                return Err(Error::SizeZero);
+            }
+            if s % 2 != 0 {
+                return Err(Error::SizeOdd);
+            }
+            n[k] = usize::try_from(s).map_err(|_| Error::TooLarge)?;
+            if d.boundary[k][0] != d.boundary[k][1]
+                && (d.boundary[k][0] == Boundary::Periodic || d.boundary[k][1] == Boundary::Periodic)
+            {
+                return Err(Error::PeriodicMismatch);
+            }
+        }
+        // M1: masses, restitutions, dt and every force parameter.
+        mass(d.mass)?;
+        restitution(d.restitution)?;
+        restitution(d.wall_restitution)?;
+        finite(&[d.dt])?;
+        if d.dt < 0.0 {
+            return Err(Error::NegativeDt);
+        }
+        finite(&d.gravity)?;
+        finite(&[d.vortex.centre[0], d.vortex.centre[1], d.vortex.core_radius, d.vortex.circulation])?;
+        if d.forces.vortex && d.vortex.core_radius <= 0.0 {
+            return Err(Error::BadVortex);
+        }
+        if d.quantization == Quantization::Bits16 && !cfg!(feature = "q16") {
+            return Err(Error::Q16Disabled);
+        }
+        if (d.per_particle_mass && !cfg!(feature = "mass"))
+            || (d.obstacles && !cfg!(feature = "obstacles"))
+            || (d.forces.any_field() && !cfg!(feature = "fields"))
+        {
+            return Err(Error::FeatureDisabled);
+        }
+        if d.per_particle_mass && !(1..=256).contains(&d.mass_classes) {
+            return Err(Error::CapacityRange);
+        }
+
+        // Cell indices are stored as u32 (surface table), so the cell count
+        // must fit one; every byte count below is checked against usize.
+        let cells = n[0].checked_mul(n[1]).and_then(|c| c.checked_mul(n[2])).ok_or(Error::TooLarge)?;
+        if u32::try_from(cells).is_err() {
+            return Err(Error::TooLarge);
+        }
+        let row_words = n[0].div_ceil(64);
+        let bit_plane = row_words.checked_mul(n[1] * n[2]).and_then(|w| w.checked_mul(8)).ok_or(Error::TooLarge)?;
+        // Bit planes are indexed by bit, so their bit count must fit too.
+        bit_plane.checked_mul(8).ok_or(Error::TooLarge)?;
+        let q = match d.quantization {
+            Quantization::Bits8 => 1,
+            Quantization::Bits16 => 2,
+        };
+        let per_cell = |bytes: usize, on: bool| -> Result<usize, Error> {
+            if on { cells.checked_mul(bytes).ok_or(Error::TooLarge) } else { Ok(0) }
+        };
+        let mut b = Builder { at: 0 };
+        let occupancy = b.plane(bit_plane)?;
+        let rows = b.plane(n[1] * n[2])?;
+        let summary_words = row_words.div_ceil(64);
+        let words = b.plane(summary_words * n[1] * n[2] * 8)?;
+        let obstacle = b.plane(if d.obstacles { bit_plane } else { 0 })?;
+        let velocity = b.plane(per_cell(dim * q, true)?)?;
+        let mass_index = b.plane(per_cell(1, d.per_particle_mass)?)?;
+        let life = b.plane(per_cell(2, d.lifetimes)?)?;
+        let field = b.plane(per_cell(dim * 4, d.forces.field)?)?;
+        let potential = b.plane(per_cell(4, d.forces.potential)?)?;
+        let mass_table = b.plane(if d.per_particle_mass { d.mass_classes as usize * 4 } else { 0 })?;
+        let surface_len = if d.obstacles {
+            (d.surface_capacity as usize).checked_mul(core::mem::size_of::<crate::obstacle::Surface>()).ok_or(Error::TooLarge)?
+        } else {
+            0
+        };
+        let surface = b.plane(surface_len)?;
+        let emitters = b.plane(
+            (d.emitter_capacity as usize).checked_mul(core::mem::size_of::<crate::emitter::Slot>()).ok_or(Error::TooLarge)?,
+        )?;
+        Ok(Layout {
+            n,
+            cells,
+            row_words,
+            occupancy,
+            rows,
+            words,
+            summary_words,
+            obstacle,
+            velocity,
+            mass_index,
+            life,
+            field,
+            potential,
+            mass_table,
+            surface,
+            emitters,
+            total: b.at,
+        })
+    }
+}
+
+struct Builder {
+    at: usize,
+}
+
+impl Builder {
+    fn plane(&mut self, len: usize) -> Result<Plane, Error> {
+        let off = self.at;
+        let end = off.checked_add(len).and_then(|e| e.checked_add(7)).ok_or(Error::TooLarge)? & !7;
+        // Slices may not exceed isize::MAX bytes.
+        if end > isize::MAX as usize / 2 {
+            return Err(Error::TooLarge);
+        }
+        self.at = end;
+        Ok(Plane { off, len })
+    }
+}
+
+/// Mutable views of every plane, borrowed together.
+pub(crate) struct Planes<'a, Q> {
+    pub occupancy: &'a mut [u64],
+    pub rows: &'a mut [u8],
+    pub words: &'a mut [u64],
+    pub obstacle: &'a mut [u64],
+    pub velocity: &'a mut [Q],
+    pub mass_index: &'a mut [u8],
+    pub life: &'a mut [u16],
+    pub field: &'a mut [f32],
+    pub potential: &'a mut [f32],
+    pub mass_table: &'a mut [f32],
+    pub surface: &'a mut [Surface],
+    pub emitters: &'a mut [Slot],
+}
+
+/// Where a cell lives in the planes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Site {
+    /// Dense index `x + nx (y + ny z)`.
+    pub cell: usize,
+    /// Bit index in a bit plane (rows padded to whole words).
+    pub bit: usize,
+    /// The cell's row `y + ny z`, its index in the row flags.
+    pub row: usize,
+    /// The cell's x.
+    pub x: usize,
+}
+
+/// Notes that cell `x` of row `row` now holds a particle: sets the row's
+/// flag and its summary bit for the occupancy word holding the cell, so the
+/// step does not skip them (M3). `summary_words` words per row.
+#[inline]
+pub(crate) fn mark(rows: &mut [u8], words: &mut [u64], summary_words: usize, row: usize, x: usize) {
+    rows[row] = 1;
+    let w = x >> 6;
+    words[row * summary_words + (w >> 6)] |= 1 << (w & 63);
+}
+
+#[inline]
+pub(crate) fn test_bit(plane: &[u64], bit: usize) -> bool {
+    plane.get(bit >> 6).is_some_and(|w| w >> (bit & 63) & 1 != 0)
+}
+
+#[inline]
+pub(crate) fn put_bit(plane: &mut [u64], bit: usize, on: bool) {
+    if let Some(w) = plane.get_mut(bit >> 6) {
+        let m = 1u64 << (bit & 63);
+        if on { *w |= m } else { *w &= !m }
+    }
+}
+
+impl Layout {
+    /// The site of in-range coordinates.
+    #[inline]
+    pub(crate) fn site(&self, x: usize, y: usize, z: usize) -> Site {
+        let row = y + self.n[1] * z;
+        Site { cell: x + self.n[0] * row, bit: row * self.row_words * 64 + x, row, x }
+    }
+}

@@ -1,0 +1,257 @@
+//! What a world can be asked: a cell, every particle, densities for a
+//! texture, statistics (M10).
+
+use crate::quant::{with_quant, Quant};
+use crate::world::{World, ENERGY_SCALE};
+use crate::Error;
+
+/// One particle as the queries report it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Particle {
+    /// Cell coordinates; the third is 0 in 2D.
+    pub pos: [u32; 3],
+    /// Velocity in cells per step; the third is 0 in 2D.
+    pub velocity: [f32; 3],
+    /// Mass.
+    pub mass: f32,
+    /// Steps left to live, 0 for no limit.
+    pub life: u16,
+}
+
+/// What one cell holds (M1).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Cell {
+    /// Nothing.
+    Empty,
+    /// An obstacle.
+    Obstacle,
+    /// A particle.
+    Particle(Particle),
+}
+
+/// Statistics of a world (M10).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Stats {
+    /// Steps taken.
+    pub step: u64,
+    /// Particles now; always `added + emitted - exited - expired - removed`.
+    pub particles: u64,
+    /// Particles placed by emitters.
+    pub emitted: u64,
+    /// Particles that left by open faces.
+    pub exited: u64,
+    /// Particles whose lifetime ended.
+    pub expired: u64,
+    /// Particles emitters could not place for lack of room.
+    pub emit_shortfall: u64,
+    /// Total momentum `sum m v`.
+    pub momentum: [f64; 3],
+    /// Total kinetic energy `sum m |v|^2 / 2`.
+    pub kinetic_energy: f64,
+    /// Particle-particle collisions (M5.2), all steps.
+    pub collisions: u64,
+    /// Velocities scaled back to `|v| = 1` (M5.5), all steps.
+    pub clamps: u64,
+    /// Kinetic energy those clamps removed, all steps.
+    pub clamp_energy: f64,
+    /// Particles not placed in their desired cell (M5.6), all steps.
+    pub displaced: u64,
+    /// Blocks processed in the last step.
+    pub blocks_processed: u64,
+    /// Blocks skipped as empty in the last step (M3).
+    pub blocks_skipped: u64,
+    /// Bytes of the world's memory per cell.
+    pub bytes_per_cell: f64,
+}
+
+impl World {
+    fn velocity_at(&self, cell: usize) -> [f32; 3] {
+        let d = self.dim();
+        let mut v = [0.0f32; 3];
+        with_quant!(self.head.desc.quantization, Q => {
+            let plane: &[Q] = self.plane(self.layout().velocity);
+            for (k, out) in v.iter_mut().enumerate().take(d) {
+                *out = plane[cell * d + k].get();
+            }
+        });
+        v
+    }
+
+    pub(crate) fn mass_at(&self, cell: usize) -> f32 {
+        if self.head.desc.per_particle_mass {
+            let idx: &[u8] = self.plane(self.layout().mass_index);
+            let table: &[f32] = self.plane(self.layout().mass_table);
+            table[usize::from(idx[cell])]
+        } else {
+            self.head.desc.mass
+        }
+    }
+
+    pub(crate) fn particle_at(&self, pos: [u32; 3], cell: usize) -> Particle {
+        let life = if self.head.desc.lifetimes { self.plane::<u16>(self.layout().life)[cell] } else { 0 };
+        Particle { pos, velocity: self.velocity_at(cell), mass: self.mass_at(cell), life }
+    }
+
+    /// What the cell at `pos` holds.
+    pub fn cell(&self, pos: [u32; 3]) -> Result<Cell, Error> {
+        let s = self.locate(pos)?;
+        Ok(if self.occupied(s) {
+            Cell::Particle(self.particle_at(pos, s.cell))
+        } else if self.is_obstacle(s) {
+            Cell::Obstacle
+        } else {
+            Cell::Empty
+        })
+    }
+
+    /// Every particle, in cell order (x fastest).
+    pub fn particles(&self) -> Particles<'_> {
+        Particles { world: self, word: 0, bits: 0, words: self.plane::<u64>(self.layout().occupancy) }
+    }
+
+    /// Fills `out` with the share of cells holding a particle in each of
+    /// `res` bins per axis (x fastest; the third is 1 in 2D). Bin `i` along
+    /// an axis of `n` cells covers cells `i n / r .. (i+1) n / r`.
+    pub fn density(&self, res: [u32; 3], out: &mut [f32]) -> Result<(), Error> {
+        self.bin(res, out.len(), |i, hit, total| out[i] = hit as f32 / total as f32)
+    }
+
+    /// As [`World::density`], scaled to `0..=255` for a texture upload.
+    pub fn density_u8(&self, res: [u32; 3], out: &mut [u8]) -> Result<(), Error> {
+        // In u64: hit * 255 can overflow a 32-bit usize.
+        self.bin(res, out.len(), |i, hit, total| {
+            out[i] = ((hit as u64 * 255 + total as u64 / 2) / total as u64) as u8
+        })
+    }
+
+    fn bin(&self, res: [u32; 3], len: usize, mut put: impl FnMut(usize, usize, usize)) -> Result<(), Error> {
+        let l = *self.layout();
+        let mut r = [1usize; 3];
+        for k in 0..3 {
+            r[k] = res[k] as usize;
+            let used = k < self.dim();
+            if r[k] == 0 || r[k] > l.n[k] || (!used && r[k] != 1) {
+                return Err(Error::BadResolution);
+            }
+        }
+        if r[0].checked_mul(r[1]).and_then(|v| v.checked_mul(r[2])) != Some(len) {
+            return Err(Error::BadResolution);
+        }
+        let occ: &[u64] = self.plane(l.occupancy);
+        // In u64: i * n can overflow a 32-bit usize; the result is <= n.
+        let edge = |k: usize, i: usize| (i as u64 * l.n[k] as u64 / r[k] as u64) as usize;
+        let mut i = 0;
+        for bz in 0..r[2] {
+            for by in 0..r[1] {
+                for bx in 0..r[0] {
+                    let (x0, x1) = (edge(0, bx), edge(0, bx + 1));
+                    let (y0, y1) = (edge(1, by), edge(1, by + 1));
+                    let (z0, z1) = (edge(2, bz), edge(2, bz + 1));
+                    let mut hit = 0;
+                    for z in z0..z1 {
+                        for y in y0..y1 {
+                            hit += count_bits(occ, l.site(x0, y, z).bit, x1 - x0);
+                        }
+                    }
+                    put(i, hit, (x1 - x0) * (y1 - y0) * (z1 - z0));
+                    i += 1;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Statistics now; momentum and energy are summed over the particles.
+    pub fn stats(&self) -> Stats {
+        let c = self.head.counters;
+        let mut momentum = [0.0f64; 3];
+        let mut kinetic_energy = 0.0f64;
+        for p in self.particles() {
+            let m = f64::from(p.mass);
+            let mut v2 = 0.0;
+            for k in 0..3 {
+                let v = f64::from(p.velocity[k]);
+                momentum[k] += m * v;
+                v2 += v * v;
+            }
+            kinetic_energy += 0.5 * m * v2;
+        }
+        Stats {
+            step: self.head.step,
+            particles: c.particles,
+            emitted: c.emitted,
+            exited: c.exited,
+            expired: c.expired,
+            emit_shortfall: c.shortfall,
+            momentum,
+            kinetic_energy,
+            collisions: c.collisions,
+            clamps: c.clamps,
+            clamp_energy: c.clamp_energy as f64 / ENERGY_SCALE,
+            displaced: c.displaced,
+            blocks_processed: c.processed,
+            blocks_skipped: c.skipped,
+            bytes_per_cell: self.bytes_per_cell(),
+        }
+    }
+
+    /// Blocks processed and skipped in the last step; cheap, unlike
+    /// [`World::stats`], which sums over every particle.
+    pub fn last_step_blocks(&self) -> (u64, u64) {
+        (self.head.counters.processed, self.head.counters.skipped)
+    }
+
+    /// Particles in the world now; cheap.
+    pub fn particle_count(&self) -> u64 {
+        self.head.counters.particles
+    }
+
+    /// Bytes of this world's memory (header and planes) per cell.
+    pub fn bytes_per_cell(&self) -> f64 {
+        self.size_in_bytes() as f64 / self.layout().cells as f64
+    }
+}
+
+/// Set bits of `plane` in `bit .. bit + len`.
+fn count_bits(plane: &[u64], bit: usize, len: usize) -> usize {
+    let mut n = 0;
+    let mut at = bit;
+    let end = bit + len;
+    while at < end {
+        let take = (64 - (at & 63)).min(end - at);
+        let w = plane[at >> 6] >> (at & 63);
+        let mask = if take == 64 { u64::MAX } else { (1u64 << take) - 1 };
+        n += (w & mask).count_ones() as usize;
+        at += take;
+    }
+    n
+}
+
+/// Iterator over a world's particles, from [`World::particles`].
+pub struct Particles<'a> {
+    world: &'a World,
+    words: &'a [u64],
+    word: usize,
+    bits: u64,
+}
+
+impl Iterator for Particles<'_> {
+    type Item = Particle;
+
+    fn next(&mut self) -> Option<Particle> {
+        while self.bits == 0 {
+            let w = *self.words.get(self.word)?;
+            self.bits = w;
+            self.word += 1;
+        }
+        let b = self.bits.trailing_zeros() as usize;
+        self.bits &= self.bits - 1;
+        let l = self.world.layout();
+        let w = self.word - 1;
+        let row = w / l.row_words;
+        let x = (w % l.row_words) * 64 + b;
+        let (y, z) = (row % l.n[1], row / l.n[1]);
+        let pos = [x as u32, y as u32, z as u32];
+        Some(self.world.particle_at(pos, l.site(x, y, z).cell))
+    }
+}
