@@ -6,10 +6,11 @@
 //! comparing 16 random bits with a table entry of the stored component,
 //! assigns moves in 2D with one look-up in a table of every block state's
 //! optimal assignments, and writes back only what changed: a block where
-//! nothing moved and no velocity changed writes nothing. A velocity a stage
-//! changes (a force, a collision, a reflection) is kept in `f32` quanta,
-//! clamped after each stage (M5.5) and rounded once, when it is written
-//! back (M1).
+//! nothing moved and no velocity changed writes nothing. A velocity the
+//! force or a collision changes is kept in `f32` quanta, clamped after each
+//! stage (M5.5) and rounded back to an integer once, after the collision
+//! stage (M1); a reflection (M5.4) rounds the velocity it reflects again.
+//! The move decisions of M5.3 therefore always read integers.
 //!
 //! [`Kernel::lean`] is the same routine for the common case, blocks of a
 //! plain world (no obstacles, one mass, no lifetimes, at most a uniform
@@ -22,11 +23,14 @@
 //! 1. M5.2, if the block holds two particles or more, the pair (16 bits);
 //!    if both cells of the pair hold one, the unit vector `R` (32 or 48
 //!    bits a try);
-//! 2. M5.3 and M5.4, per particle in cell order that could move inside the
-//!    block along some axis, 16 bits per axis (32 bits, then 16 in 3D);
-//! 3. M5.6, the tie-break of the assignment, where there is a choice;
-//! 4. M1, per particle in cell order whose velocity a stage changed and
-//!    that stays in the world, one 64-bit output for its rounding.
+//! 2. M1, per particle in cell order whose velocity the force or the
+//!    collision changed, one 64-bit output for its rounding (16 bits a
+//!    component);
+//! 3. M5.3 and M5.4, per particle in cell order that could move inside the
+//!    block along some axis, 16 bits per axis (32 bits, then 16 in 3D), and
+//!    after a reflection one 64-bit output for rounding the reflected
+//!    velocity;
+//! 4. M5.6, the tie-break of the assignment, where there is a choice.
 //!
 //! M5.1 draws nothing.
 
@@ -36,7 +40,7 @@ use crate::desc::Description;
 use crate::force::ForceTerms;
 use crate::obstacle::{reflect, surface_at, Surface};
 use crate::partition::{cells_at, resolve, BlockRow, BlockSink, Beyond, Index, Partition};
-use crate::quant::{Quant, wants_move_f32};
+use crate::quant::Quant;
 use crate::rng::{StepKey, Stream};
 use crate::vector::{clamp, dot, normalise};
 use crate::layout::{mark, put_bit};
@@ -232,32 +236,46 @@ struct Wanted {
 struct Block<const D: usize, const CELLS: usize> {
     /// Cells holding a particle.
     occ: u8,
-    /// Stored velocities in quanta; what an empty cell holds is never read.
-    stored: [[i32; D]; CELLS],
-    /// Cells whose velocity a stage changed: it is `moved[c]`, in quanta,
-    /// not yet rounded.
-    changed: u8,
-    moved: [[f32; 3]; CELLS],
+    /// Velocities as stored, in quanta; what an empty cell holds is never
+    /// read.
+    v: [[i32; D]; CELLS],
+    /// Cells whose velocity a stage changed and that await their rounding:
+    /// the velocity is `x[c]`, in quanta.
+    pending: u8,
+    x: [[f32; 3]; CELLS],
+    /// Cells whose velocity differs from what the plane holds.
+    dirty: u8,
 }
 
 impl<const D: usize, const CELLS: usize> Block<D, CELLS> {
     /// The velocity of the particle in cell `c`, in quanta.
     #[inline(always)]
     fn velocity(&self, c: usize) -> [f32; 3] {
-        if self.changed >> c & 1 != 0 {
-            return self.moved[c];
+        if self.pending >> c & 1 != 0 {
+            return self.x[c];
         }
         let mut x = [0.0; 3];
         for k in 0..D {
-            x[k] = self.stored[c][k] as f32;
+            x[k] = self.v[c][k] as f32;
         }
         x
     }
 
     #[inline(always)]
     fn set(&mut self, c: usize, x: [f32; 3]) {
-        self.moved[c] = x;
-        self.changed |= 1 << c;
+        self.x[c] = x;
+        self.pending |= 1 << c;
+    }
+
+    /// M1: rounds every pending velocity back to storage, one 64-bit output
+    /// of the stream each, in cell order.
+    #[inline(always)]
+    fn round<Q: Quant>(&mut self, rng: &mut Stream) {
+        for c in cells_of(self.pending) {
+            self.v[c] = Q::round::<D>(self.x[c], rng);
+        }
+        self.dirty |= self.pending;
+        self.pending = 0;
     }
 }
 
@@ -271,20 +289,20 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
     /// neighbouring cells) at a time where the row does not wrap.
     #[inline(always)]
     fn load(&self, row: &BlockRow, xs: [usize; 2], occ: u8) -> Block<D, CELLS> {
-        let mut b = Block { occ, stored: [[0; D]; CELLS], changed: 0, moved: [[0.0; 3]; CELLS] };
+        let mut b = Block { occ, v: [[0; D]; CELLS], pending: 0, x: [[0.0; 3]; CELLS], dirty: 0 };
         let velocity = &*self.planes.velocity;
         if xs[1] == xs[0] + 1 {
             for r in 0..CELLS / 2 {
                 if occ >> (2 * r) & 3 != 0 {
                     let at = xs[0] + row.cell[r];
                     let pair = &velocity[at..at + 2];
-                    b.stored[2 * r] = pair[0].map(Q::to_int);
-                    b.stored[2 * r + 1] = pair[1].map(Q::to_int);
+                    b.v[2 * r] = pair[0].map(Q::to_int);
+                    b.v[2 * r + 1] = pair[1].map(Q::to_int);
                 }
             }
         } else {
             for c in cells_of(occ) {
-                b.stored[c] = velocity[xs[c & 1] + row.cell[c >> 1]].map(Q::to_int);
+                b.v[c] = velocity[xs[c & 1] + row.cell[c >> 1]].map(Q::to_int);
             }
         }
         b
@@ -328,36 +346,28 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
         b.set(c, xc);
     }
 
-    /// M5.3: the axes the particle in cell `c` wants to cross. Only a move
-    /// that stays inside the block can be wanted: towards +k from the low
-    /// side of the block, towards -k from the high.
+    /// M5.3: the axes the particle in cell `c` wants to cross, from its
+    /// stored (rounded) velocity. Only a move that stays inside the block can
+    /// be wanted: towards +k from the low side of the block, towards -k from
+    /// the high.
     #[inline(always)]
     fn decide(&self, b: &Block<D, CELLS>, c: usize, rng: &mut Stream) -> u8 {
-        let desc = &self.shared.desc;
-        let exact = b.changed >> c & 1 == 0;
-        let x = b.moved[c];
+        let q = b.v[c];
         let mut inward = 0u8;
         for k in 0..D {
             let low = (c >> k) & 1 == 0;
-            let positive = if exact { b.stored[c][k] > 0 } else { x[k] > 0.0 };
-            let negative = if exact { b.stored[c][k] < 0 } else { x[k] < 0.0 };
-            inward |= u8::from(if low { positive } else { negative }) << k;
+            inward |= u8::from(if low { q[k] > 0 } else { q[k] < 0 }) << k;
         }
         if inward == 0 {
             return 0;
         }
         let r = if D == 2 { u64::from(rng.bits(32)) } else { u64::from(rng.bits(32)) | u64::from(rng.bits(16)) << 32 };
+        let (table, drift) = (self.shared.moves, self.shared.desc.drift);
         let mut m = 0u8;
         for k in 0..D {
-            let bits = (r >> (16 * k)) as u32 & 0xffff;
-            let go = if exact {
-                Q::wants_move(self.shared.moves, desc.drift, b.stored[c][k], bits)
-            } else {
-                wants_move_f32(x[k] * (1.0 / Q::SCALE), desc.drift, bits)
-            };
-            m |= u8::from(inward >> k & 1 != 0 && go) << k;
+            m |= u8::from(Q::wants_move(table, drift, q[k], (r >> (16 * k)) as u32 & 0xffff)) << k;
         }
-        m
+        m & inward
     }
 
     /// M5.4: the particle in cell `c` of mass `m` wants the blocked cell
@@ -365,7 +375,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
     /// it. Rare, so kept out of the block routine's straight line.
     #[cold]
     #[inline(never)]
-    fn reflect_off(&mut self, b: &mut Block<D, CELLS>, c: usize, to: Wanted, m: f32) {
+    fn reflect_off(&mut self, b: &mut Block<D, CELLS>, c: usize, to: Wanted, m: f32, rng: &mut Stream) {
         let sh = self.shared;
         let t = to.cell;
         let mut surface = None;
@@ -390,6 +400,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
         let mut x = reflect(x, n, e); // eq. 9
         clamp_counted(&mut x, Q::SCALE, m, &mut self.counters);
         b.set(c, x);
+        b.round::<Q>(rng);
     }
 
     /// M5.6: where each particle goes, `targets >> 4c & 7` for the particle
@@ -422,15 +433,11 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
         targets
     }
 
-    /// Writes the particle of cell `c` to cell `to` of the planes: its
-    /// stored velocity, or a changed one rounded (M1).
+    /// Writes the velocity of the particle of cell `c` to cell `to` of the
+    /// planes.
     #[inline(always)]
-    fn store(&mut self, b: &Block<D, CELLS>, c: usize, to: usize, rng: &mut Stream) {
-        self.planes.velocity[to] = if b.changed >> c & 1 != 0 {
-            Q::round::<D>(b.moved[c], rng).map(Q::from_int)
-        } else {
-            b.stored[c].map(Q::from_int)
-        };
+    fn store(&mut self, b: &Block<D, CELLS>, c: usize, to: usize) {
+        self.planes.velocity[to] = b.v[c].map(Q::from_int);
     }
 
     /// Sets and clears the block's occupancy bits from `before` to `after`.
@@ -462,6 +469,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
             }
         }
         self.collide(&mut b, &mut rng, |_| mass, true);
+        b.round::<Q>(&mut rng);
         let mut want = [0u8; CELLS];
         let mut key = 0;
         each_cell!(CELLS, c => {
@@ -474,7 +482,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
         });
         let targets = self.assign(&b, 0, &want, key, &mut rng);
         self.counters.processed += 1;
-        if (targets ^ IDENTITY) & FIELDS[usize::from(occ)] == 0 && b.changed == 0 {
+        if (targets ^ IDENTITY) & FIELDS[usize::from(occ)] == 0 && b.dirty == 0 {
             return;
         }
         let cell = |c: usize| xs[c & 1] + row.cell[c >> 1];
@@ -483,8 +491,8 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
             if occ >> c & 1 != 0 {
                 let t = (targets >> (4 * c) & 7) as usize;
                 after |= 1 << t;
-                if t != c || b.changed >> c & 1 != 0 {
-                    self.store(&b, c, cell(t), &mut rng);
+                if t != c || b.dirty >> c & 1 != 0 {
+                    self.store(&b, c, cell(t));
                 }
             }
         });
@@ -553,8 +561,10 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
             }
         }
 
-        // M5.2 collision.
+        // M5.2 collision, then M1 for what the force and the collision
+        // changed.
         self.collide(&mut b, &mut rng, |c| mass[c], !desc.per_particle_mass);
+        b.round::<Q>(&mut rng);
 
         // M5.3 desired move, M5.4 obstacle reflection: `want[c]` holds the
         // axes the particle in cell c wants to cross.
@@ -565,7 +575,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
             let t = c ^ usize::from(m);
             if m != 0 && blocked >> t & 1 != 0 {
                 let to = Wanted { cell: t, site: cell(t), at: at(t), wall: wall >> t & 1 != 0 };
-                self.reflect_off(&mut b, c, to, mass[c]);
+                self.reflect_off(&mut b, c, to, mass[c], &mut rng);
                 m = 0;
             }
             want[c] = m;
@@ -579,7 +589,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
 
         // Write back what changed.
         self.counters.processed += 1;
-        if (targets ^ IDENTITY) & FIELDS[usize::from(occ)] == 0 && b.changed == 0 && !desc.lifetimes {
+        if (targets ^ IDENTITY) & FIELDS[usize::from(occ)] == 0 && b.dirty == 0 && !desc.lifetimes {
             return;
         }
         let mut after = 0u8;
@@ -593,8 +603,8 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
             } else {
                 after |= 1 << t;
                 let to = cell(t);
-                if t != c || b.changed >> c & 1 != 0 {
-                    self.store(&b, c, to, &mut rng);
+                if t != c || b.dirty >> c & 1 != 0 {
+                    self.store(&b, c, to);
                 }
                 if desc.per_particle_mass && t != c {
                     self.planes.mass_index[to] = mass_index[c];

@@ -82,19 +82,6 @@ pub(crate) trait Quant: Copy + Default + crate::layout::Plain + 'static {
     fn wants_move(table: &[u16; 256], drift: Drift, q: i32, r: u32) -> bool;
 }
 
-/// M5.3 for a velocity component `v` in cells per step (not an integer in
-/// quanta: one a stage changed this step): whether 16 random bits `r` say
-/// "move", `r` below `p 2^16` rounded, as [`Quant::wants_move`].
-#[inline]
-pub(crate) fn wants_move_f32(v: f32, drift: Drift, r: u32) -> bool {
-    let a = v.abs().min(1.0);
-    let p = match drift {
-        Drift::Paper => a,
-        Drift::Calibrated => 2.0 * a / (1.0 + a),
-    };
-    r < (p * 65536.0 + 0.5) as u32
-}
-
 /// `round(p 2^16)` for `p = a/127` (paper) and `p = 2a/(127 + a)`
 /// (calibrated), `a` in quanta, in integers so the tables are exact and the
 /// same on every target.
@@ -161,7 +148,12 @@ impl Quant for i16 {
     fn wants_move(_: &[u16; 256], drift: Drift, q: i32, r: u32) -> bool {
         // 32,768 thresholds would not fit a table; f32 holds a/32767 to
         // 2^-24, far finer than the 2^-16 steps of the threshold.
-        wants_move_f32(q as f32 * (1.0 / Self::SCALE), drift, r)
+        let a = q.unsigned_abs().min(32767) as f32 * (1.0 / Self::SCALE);
+        let p = match drift {
+            Drift::Paper => a,
+            Drift::Calibrated => 2.0 * a / (1.0 + a),
+        };
+        r < (p * 65536.0 + 0.5) as u32
     }
 }
 
