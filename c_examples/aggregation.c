@@ -1,5 +1,5 @@
 /*
- * 4.1 aggregation (Ecchu, Takai, Sato 1993; MODEL.md "The paper's scenes"):
+ * 4.1 aggregation (Ecchu, Takai, Sato 1993; docs/model.md "The paper's four scenes"):
  * a periodic 2D box, 30 % of the cells holding a particle with a random
  * velocity, no force, particle-particle restitution e = 0.5. Inelastic
  * collisions cool the gas and the particles gather into clusters.

@@ -1,6 +1,6 @@
 /*
- * 4.2 cluster collision (Ecchu, Takai, Sato 1993; MODEL.md "The paper's
- * scenes"): two discs of particles, radius 10 cells, flying at each other
+ * 4.2 cluster collision (Ecchu, Takai, Sato 1993; docs/model.md "The paper's
+ * four scenes"): two discs of particles, radius 10 cells, flying at each other
  * with v = (+-0.8, 0), e = 1, m = 1, in a 2D box with walls all round.
  * The same scene as tests/src/scenes.rs `cluster()`; at another --size the
  * discs' centres and radius scale with it.

@@ -1,5 +1,5 @@
 /*
- * 4.3 smoke (Ecchu, Takai, Sato 1993; MODEL.md "The paper's scenes"):
+ * 4.3 smoke (Ecchu, Takai, Sato 1993; docs/model.md "The paper's four scenes"):
  * about one particle per step emitted at the bottom with a rising velocity,
  * swirled by a static Rankine vortex force, e = 1, one mass. The same scene
  * as tests/src/scenes.rs `smoke()`: 128 x 128 (the paper gives no size), a

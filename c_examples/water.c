@@ -1,5 +1,5 @@
 /*
- * 4.4 water (Ecchu, Takai, Sato 1993; MODEL.md "The paper's scenes"): a 3D
+ * 4.4 water (Ecchu, Takai, Sato 1993; docs/model.md "The paper's four scenes"): a 3D
  * box of 64^3 cells with walls, water poured in at the top, gravity, a
  * sphere obstacle in the middle, e = 1. The same scene as
  * tests/src/scenes.rs `water()`: y is up, the sphere of radius 10 is centred

@@ -22,13 +22,13 @@
 //! number of axes on which they differ: local cell `c` has offset
 //! `(c >> k) & 1` along axis `k`, so it is `popcount(a ^ b)`.
 //!
-//! Three methods, all selectable (MODEL.md M5.6):
+//! Three methods, all selectable (docs/model.md M5.6):
 //! - [`Method::Exhaustive`], the paper's: every permutation of the particles
 //!   over the free cells, one optimal leaf kept by reservoir sampling. The
 //!   reference for the others.
 //! - [`Method::ExactFast`]: the same optimum, uniform over the optimal
 //!   assignments. In 2D a table built at compile time holds, for each of the
-//!   4096 block states, every optimal assignment; in 3D a dynamic programme
+//!   1296 block states, every optimal assignment; in 3D a dynamic programme
 //!   over subsets of the 8 cells counts the optimal completions of every
 //!   partial assignment and one draw picks among them.
 //! - [`Method::Greedy`], the paper's 3D approximation: the particles, fastest

@@ -3,7 +3,7 @@
 //! A `no_std` implementation of the particle model of Ecchu, Takai and Sato,
 //! "Particle Motion Modeling by Cellular Automata and its Applications"
 //! (1993), for 2D and 3D from one code path. The rules are numbered as in
-//! the project's `MODEL.md` (M1-M10) and cited where they are implemented.
+//! `docs/model.md` (M1-M12) and cited where they are implemented.
 //!
 //! A world lives in memory the caller hands in; nothing is allocated.
 //!

@@ -19,8 +19,9 @@
 //! loops need a handful.
 //!
 //! Draws take as many bits as they need from the current 64-bit output
-//! ([`Stream::bits`]): a move decision 16, a stochastic rounding 24, a pair
-//! choice or a tie-break 16 or 32, so a typical 2D block uses one output.
+//! ([`Stream::bits`]): a move decision 16 a component, a pair choice or a
+//! tie-break 16 (32 above 2^16), so a typical 2D block uses one output; a
+//! stochastic rounding takes a whole output (16 bits a component).
 
 /// Domain tags keep the block streams and the emitter streams apart even
 /// where a block index equals an emitter index.

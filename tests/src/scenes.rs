@@ -1,5 +1,5 @@
-//! The paper's four scenes (section 4; MODEL.md, "The paper's scenes and
-//! figures"), as descriptions plus a function that fills a fresh world.
+//! The paper's four scenes (section 4; docs/model.md, "The paper's four
+//! scenes"), as descriptions plus a function that fills a fresh world.
 //! Where the paper gives no figure (the smoke domain, the water emitter), the
 //! choice is written next to it.
 

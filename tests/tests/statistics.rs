@@ -1,5 +1,5 @@
 //! Statistical checks of the local map and the emitters, each against a
-//! probability derived from MODEL.md, with fixed seeds and bands of five
+//! probability derived from docs/model.md, with fixed seeds and bands of five
 //! standard deviations derived from the variance (binomial, or the sample
 //! variance across independent particles).
 //!

@@ -1,4 +1,4 @@
-//! The measurements of MODEL.md M10: error against run time, per scene,
+//! The measurements of docs/model.md M10: error against run time, per scene,
 //! assignment method (M5.6), drift rule (M5.3) and velocity quantization
 //! (M1). Each submodule measures one kind of error on purpose-built scenes
 //! (or the paper's, `scenes`) and returns plain numbers; the report program

@@ -1,4 +1,4 @@
-//! The error report of MODEL.md M10: error against run time for every
+//! The error report of docs/model.md M10: error against run time for every
 //! assignment method, drift rule and quantization, on the paper's four
 //! scenes and on purpose-built ones.
 //!
