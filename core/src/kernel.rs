@@ -13,9 +13,9 @@
 //! The move decisions of M5.3 therefore always read integers.
 //!
 //! [`Kernel::lean`] is the same routine for the common case, blocks of a
-//! plain world (no obstacles, one mass, no lifetimes, at most a uniform
-//! force) away from the faces, without the code for what such a block
-//! cannot hold; [`Kernel::general`] handles everything. Both draw the same
+//! plain world (one mass, no lifetimes, at most a uniform force) away from
+//! the faces and without an obstacle, without the code for what such a
+//! block cannot hold; [`Kernel::general`] handles everything. Both draw the same
 //! numbers in the same order, so they give the same world bit for bit, and
 //! the tests hold them to it.
 //!
@@ -63,8 +63,8 @@ pub(crate) struct Shared<'a> {
     pub dt_q: f32,
     /// The 8-bit move table of the drift rule (M5.3).
     pub moves: &'static [u16; 256],
-    /// No obstacles, one mass, no lifetimes: blocks away from the faces go
-    /// through [`Kernel::lean`].
+    /// One mass, no lifetimes: blocks away from the faces and without an
+    /// obstacle go through [`Kernel::lean`].
     pub plain: bool,
 }
 
@@ -453,9 +453,10 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
         }
     }
 
-    /// The local map of M5 on a block of a plain world (no obstacles, one
-    /// mass, no lifetimes, no force but a uniform one) away from the faces:
-    /// [`Kernel::general`] without what such a block cannot have. Cell `c`
+    /// The local map of M5 on a block of a plain world (one mass, no
+    /// lifetimes, no force but a uniform one) away from the faces and
+    /// without an obstacle: [`Kernel::general`] without what such a block
+    /// cannot have. Cell `c`
     /// has x `xs[c & 1]` in block row `c >> 1`.
     #[inline(always)]
     fn lean(&mut self, row: &BlockRow, xs: [usize; 2], index: u64, occ: u8) {
@@ -632,7 +633,10 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> BlockSin
             let x0 = x0 as usize;
             let x1 = if x0 + 1 < sh.n[0] { Some(x0 + 1) } else { sh.part.axes[0].periodic.then_some(0) };
             if let Some(x1) = x1 {
-                return self.lean(row, [x0, x1], row.index + bx as u64, occ);
+                // A world with obstacles: only blocks without one are lean.
+                if !sh.desc.obstacles || read_block::<CELLS>(sh.obstacle, row, [x0, x1]) == 0 {
+                    return self.lean(row, [x0, x1], row.index + bx as u64, occ);
+                }
             }
         }
         self.general(row, x0, bx, occ);

@@ -113,7 +113,7 @@ impl World {
             terms,
             dt_q,
             moves: crate::quant::move_table_8(desc.drift),
-            plain: route.lean && !desc.obstacles && !desc.per_particle_mass && !desc.lifetimes,
+            plain: route.lean && !desc.per_particle_mass && !desc.lifetimes,
         };
         let c = visit(&shared, Writable { occupancy, rows, words, velocity: groups(velocity), mass_index, life }, route.reverse);
         let h = &mut head.counters;

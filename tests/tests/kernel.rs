@@ -1,6 +1,6 @@
 //! The step has two block routines: a lean one for blocks of plain worlds
-//! (no obstacles, one mass, no lifetimes, at most a uniform force) away
-//! from the faces, and one that handles every part; and it skips rows and
+//! (one mass, no lifetimes, at most a uniform force) away from the faces and
+//! without an obstacle, and one that handles every part; and it skips rows and
 //! words of the occupancy that its summaries say are empty. Both routines
 //! draw the same numbers in the same order (M8), so a world stepped with
 //! every block through the general routine and every row and word swept
@@ -17,9 +17,16 @@ fn gas<'a>(desc: &Description, density: f32, speed: f32, seed: u64, memory: &'a 
     memory.clear();
     memory.resize(mpca::world_bytes(desc).unwrap(), 0);
     let world = World::init(desc, memory).unwrap();
+    if desc.obstacles {
+        // A round obstacle in the middle: blocks touching it take the general
+        // routine, the others the lean one.
+        let c = desc.size.map(|s| s as f32 / 2.0);
+        let shape = if desc.dim == 2 { Shape::Disc { centre: [c[0], c[1]], radius: 3.5 } } else { Shape::Sphere { centre: c, radius: 2.5 } };
+        world.add_shape(shape, 0.8).unwrap();
+    }
     let mut rng = common::test_rng(seed);
     for pos in common::cells(desc).collect::<Vec<_>>() {
-        if rng.unit() < density {
+        if rng.unit() < density && !world.obstacle_at(pos) {
             world.add_particle(pos, rng.velocity(desc.dim, speed)).unwrap();
         }
     }
@@ -28,7 +35,8 @@ fn gas<'a>(desc: &Description, density: f32, speed: f32, seed: u64, memory: &'a 
 
 /// Every plain setting: 2D and 3D; periodic, walled and open faces (whose
 /// half blocks take the general routine in both runs); no force and
-/// gravity; both widths, both drift rules, all three methods.
+/// gravity; with and without an obstacle; both widths, both drift rules,
+/// all three methods.
 fn settings() -> Vec<Description> {
     let mut out = vec![];
     for dim in [2u32, 3] {
@@ -43,6 +51,10 @@ fn settings() -> Vec<Description> {
                 if variant % 2 == 1 {
                     d.forces.uniform = true;
                     d.gravity = [0.004, -0.03, 0.01];
+                }
+                if variant >= 2 {
+                    d.obstacles = true;
+                    d.surface_capacity = 512;
                 }
                 d.seed = 900 + 10 * u64::from(dim) + (4 * i + variant) as u64;
                 out.push(d);
