@@ -405,9 +405,21 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
 
     /// M5.6: where each particle goes, `targets >> 4c & 7` for the particle
     /// in cell `c`, counting those not placed in their desired cell. `want`
-    /// holds the axes each wants to cross; `key` is the 2D table key.
+    /// holds the axes each wants to cross (a desired cell is never blocked:
+    /// M5.4 has turned such a wish into staying), `wanted` their union;
+    /// `key` is the 2D table key.
     #[inline(always)]
-    fn assign(&mut self, b: &Block<D, CELLS>, blocked: u8, want: &[u8; CELLS], key: usize, rng: &mut Stream) -> u32 {
+    fn assign(&mut self, b: &Block<D, CELLS>, blocked: u8, want: &[u8; CELLS], wanted: u8, key: usize, rng: &mut Stream) -> u32 {
+        // Where nobody wants to move, or the block holds one particle, the
+        // optimum is unique (everyone stays; the particle takes the free cell
+        // it wants) and no method draws for it: take it directly.
+        if wanted == 0 {
+            return IDENTITY;
+        }
+        if b.occ & (b.occ - 1) == 0 {
+            let c = b.occ.trailing_zeros() as usize;
+            return IDENTITY ^ u32::from(want[c]) << (4 * c);
+        }
         let method = self.shared.desc.method;
         if D == 2 && method == Method::ExactFast {
             let packed = pick_move(optimal_moves_2d(key), rng);
@@ -472,16 +484,17 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
         self.collide(&mut b, &mut rng, |_| mass, true);
         b.round::<Q>(&mut rng);
         let mut want = [0u8; CELLS];
-        let mut key = 0;
+        let (mut key, mut wanted) = (0, 0u8);
         each_cell!(CELLS, c => {
             if occ >> c & 1 != 0 {
                 want[c] = self.decide(&b, c, &mut rng);
+                wanted |= want[c];
                 if D == 2 {
                     key += usize::from(PLACE_2D[c & 3]) * usize::from(2 + want[c]);
                 }
             }
         });
-        let targets = self.assign(&b, 0, &want, key, &mut rng);
+        let targets = self.assign(&b, 0, &want, wanted, key, &mut rng);
         self.counters.processed += 1;
         if (targets ^ IDENTITY) & FIELDS[usize::from(occ)] == 0 && b.dirty == 0 {
             return;
@@ -570,6 +583,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
         // M5.3 desired move, M5.4 obstacle reflection: `want[c]` holds the
         // axes the particle in cell c wants to cross.
         let mut want = [0u8; CELLS];
+        let mut wanted = 0u8;
         let mut key = if D == 2 { usize::from(BLOCKED_KEY_2D[usize::from(blocked & 15)]) } else { 0 };
         for c in cells_of(occ) {
             let mut m = self.decide(&b, c, &mut rng);
@@ -580,13 +594,14 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
                 m = 0;
             }
             want[c] = m;
+            wanted |= m;
             if D == 2 {
                 key += usize::from(PLACE_2D[c & 3]) * usize::from(2 + m);
             }
         }
 
         // M5.6 move.
-        let targets = self.assign(&b, blocked, &want, key, &mut rng);
+        let targets = self.assign(&b, blocked, &want, wanted, key, &mut rng);
 
         // Write back what changed.
         self.counters.processed += 1;
