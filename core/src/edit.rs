@@ -2,6 +2,7 @@
 //! own), removing one, and the placement the emitters share (M1, M6, M9).
 //! Every edit checks everything before it changes anything.
 
+use crate::cells::Cells;
 use crate::layout::{mark, put_bit, Site};
 use crate::quant::{with_quant, Quant};
 use crate::query::Particle;
@@ -78,8 +79,8 @@ impl World {
         let lifetimes = self.head.desc.lifetimes;
         with_quant!(self.head.desc.quantization, Q => {
             let (_, p) = self.planes::<Q>();
-            put_bit(p.occupancy, s.bit, true);
-            mark(p.rows, p.words, summary_words, s.row, s.x);
+            put_bit(Cells::new(p.occupancy), s.bit, true);
+            mark(Cells::new(p.rows), Cells::new(p.words), summary_words, s.row, s.x);
             let r = stream.map(|rng| rng.next_u64());
             for k in 0..d {
                 p.velocity[s.cell * d + k] = match r {
@@ -104,7 +105,7 @@ impl World {
         }
         let p = self.particle_at(pos, s.cell);
         let (head, planes) = self.planes::<u8>();
-        put_bit(planes.occupancy, s.bit, false);
+        put_bit(Cells::new(planes.occupancy), s.bit, false);
         head.counters.particles -= 1;
         Ok(p)
     }

@@ -35,6 +35,7 @@
 //! M5.1 draws nothing.
 
 use crate::assign::{assign_moves, optimal_moves_2d, pick_move, Method, MoveProblem, PLACE_2D};
+use crate::cells::Cells;
 use crate::collision::{block_pairs, collide_pair, pair_holds_two, random_unit, shares};
 use crate::desc::Description;
 use crate::force::ForceTerms;
@@ -69,14 +70,16 @@ pub(crate) struct Shared<'a> {
 }
 
 /// The planes a step writes; `velocity` holds a cell's `D` components
-/// together.
+/// together. Copies go to the tasks of a parallel step, which write
+/// disjoint elements ([`Cells`]).
+#[derive(Clone, Copy)]
 pub(crate) struct Writable<'a, Q, const D: usize> {
-    pub occupancy: &'a mut [u64],
-    pub rows: &'a mut [u8],
-    pub words: &'a mut [u64],
-    pub velocity: &'a mut [[Q; D]],
-    pub mass_index: &'a mut [u8],
-    pub life: &'a mut [u16],
+    pub occupancy: Cells<'a, u64>,
+    pub rows: Cells<'a, u8>,
+    pub words: Cells<'a, u64>,
+    pub velocity: Cells<'a, [Q; D]>,
+    pub mass_index: Cells<'a, u8>,
+    pub life: Cells<'a, u16>,
 }
 
 /// The block routine, specialised once per step (M9) on the stored velocity
@@ -290,19 +293,19 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
     #[inline(always)]
     fn load(&self, row: &BlockRow, xs: [usize; 2], occ: u8) -> Block<D, CELLS> {
         let mut b = Block { occ, v: [[0; D]; CELLS], pending: 0, x: [[0.0; 3]; CELLS], dirty: 0 };
-        let velocity = &*self.planes.velocity;
+        let velocity = self.planes.velocity;
         if xs[1] == xs[0] + 1 {
             for r in 0..CELLS / 2 {
                 if occ >> (2 * r) & 3 != 0 {
                     let at = xs[0] + row.cell[r];
-                    let pair = &velocity[at..at + 2];
+                    let pair = velocity.pair(at);
                     b.v[2 * r] = pair[0].map(Q::to_int);
                     b.v[2 * r + 1] = pair[1].map(Q::to_int);
                 }
             }
         } else {
             for c in cells_of(occ) {
-                b.v[c] = velocity[xs[c & 1] + row.cell[c >> 1]].map(Q::to_int);
+                b.v[c] = velocity.get(xs[c & 1] + row.cell[c >> 1]).map(Q::to_int);
             }
         }
         b
@@ -449,7 +452,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
     /// planes.
     #[inline(always)]
     fn store(&mut self, b: &Block<D, CELLS>, c: usize, to: usize) {
-        self.planes.velocity[to] = b.v[c].map(Q::from_int);
+        self.planes.velocity.set(to, b.v[c].map(Q::from_int));
     }
 
     /// Sets and clears the block's occupancy bits from `before` to `after`.
@@ -548,11 +551,11 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
         let mut life = [0u16; CELLS];
         for c in cells_of(occ) {
             if desc.per_particle_mass {
-                mass_index[c] = self.planes.mass_index[cell(c)];
+                mass_index[c] = self.planes.mass_index.get(cell(c));
                 mass[c] = sh.mass_table[usize::from(mass_index[c])];
             }
             if desc.lifetimes {
-                life[c] = self.planes.life[cell(c)];
+                life[c] = self.planes.life.get(cell(c));
             }
         }
         let mut rng = sh.key.stream(row.index + bx as u64);
@@ -623,10 +626,10 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
                     self.store(&b, c, to);
                 }
                 if desc.per_particle_mass && t != c {
-                    self.planes.mass_index[to] = mass_index[c];
+                    self.planes.mass_index.set(to, mass_index[c]);
                 }
                 if desc.lifetimes {
-                    self.planes.life[to] = life[c].saturating_sub(1);
+                    self.planes.life.set(to, life[c].saturating_sub(1));
                 }
             }
         }
@@ -637,7 +640,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
 impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> BlockSink for Kernel<'_, Q, D, CELLS, GENERAL> {
     const CELLS: usize = CELLS;
 
-    fn index(&mut self) -> Index<'_> {
+    fn index(&self) -> Index<'_> {
         Index { occupancy: self.planes.occupancy, rows: self.planes.rows, words: self.planes.words }
     }
 

@@ -6,6 +6,7 @@
 
 use core::mem::{align_of, size_of};
 
+use crate::cells::Cells;
 use crate::desc::{finite, mass, restitution, Boundary, Description, Quantization};
 use crate::emitter::Slot;
 use crate::obstacle::Surface;
@@ -258,10 +259,11 @@ pub(crate) struct Site {
 /// flag and its summary bit for the occupancy word holding the cell, so the
 /// step does not skip them (M3). `summary_words` words per row.
 #[inline]
-pub(crate) fn mark(rows: &mut [u8], words: &mut [u64], summary_words: usize, row: usize, x: usize) {
-    rows[row] = 1;
+pub(crate) fn mark(rows: Cells<'_, u8>, words: Cells<'_, u64>, summary_words: usize, row: usize, x: usize) {
+    rows.set(row, 1);
     let w = x >> 6;
-    words[row * summary_words + (w >> 6)] |= 1 << (w & 63);
+    let at = row * summary_words + (w >> 6);
+    words.set(at, words.get(at) | 1 << (w & 63));
 }
 
 #[inline]
@@ -270,10 +272,12 @@ pub(crate) fn test_bit(plane: &[u64], bit: usize) -> bool {
 }
 
 #[inline]
-pub(crate) fn put_bit(plane: &mut [u64], bit: usize, on: bool) {
-    if let Some(w) = plane.get_mut(bit >> 6) {
+pub(crate) fn put_bit(plane: Cells<'_, u64>, bit: usize, on: bool) {
+    let at = bit >> 6;
+    if at < plane.len() {
         let m = 1u64 << (bit & 63);
-        if on { *w |= m } else { *w &= !m }
+        let w = plane.get(at);
+        plane.set(at, if on { w | m } else { w & !m });
     }
 }
 

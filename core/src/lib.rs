@@ -37,7 +37,11 @@
 // equations do; iterator chains would hide that.
 #![allow(clippy::needless_range_loop)]
 
+#[cfg(feature = "std")]
+extern crate std;
+
 pub mod assign;
+mod cells;
 mod collision;
 mod desc;
 mod edit;
@@ -55,6 +59,8 @@ mod quant;
 mod query;
 pub mod rng;
 mod step;
+#[cfg(target_has_atomic = "8")]
+mod tasks;
 mod vector;
 mod world;
 
@@ -66,6 +72,8 @@ pub use obstacle::{Shape, Surface};
 #[cfg(feature = "alloc")]
 pub use owned::WorldBox;
 pub use step::Order;
+#[cfg(target_has_atomic = "8")]
+pub use tasks::{Host, MAX_TASKS};
 pub use query::{Cell, Particle, Particles, Stats};
 pub use world::{world_bytes, World, WORLD_ALIGN};
 

@@ -9,6 +9,7 @@
 //! undefined is refused, and so is anything that does not fit: adding an
 //! obstacle either succeeds whole or changes nothing.
 
+use crate::cells::Cells;
 use crate::desc::{finite, restitution};
 use crate::partition::{resolve, Beyond};
 use crate::vector::{dot, normalise};
@@ -374,7 +375,7 @@ impl World {
         // Pass 2: the bits, then the entries, read off the plane as it now is.
         // Nothing here can fail: pass 1 checked every cell.
         each(&mut |c| {
-            put_bit(self.planes::<u8>().1.obstacle, site(c).bit, true);
+            put_bit(Cells::new(self.planes::<u8>().1.obstacle), site(c).bit, true);
             Ok(())
         })?;
         each(&mut |c| {

@@ -16,6 +16,9 @@
 //! occupancy rows of a row of blocks are OR-ed together, folded pairwise, and
 //! only the set bits of the fold are visited.
 
+use core::ops::Range;
+
+use crate::cells::Cells;
 use crate::desc::Boundary;
 use crate::layout::Layout;
 use crate::vector::normalise;
@@ -108,14 +111,15 @@ pub(crate) struct BlockRow {
 
 /// What the sweep reads to find the occupied blocks, and the summaries it
 /// keeps exact for the rows it sweeps.
+#[derive(Clone, Copy)]
 pub(crate) struct Index<'a> {
     /// The occupancy plane.
-    pub occupancy: &'a [u64],
+    pub occupancy: Cells<'a, u64>,
     /// A byte per domain row: 0 where the row holds no particle for sure.
-    pub rows: &'a mut [u8],
+    pub rows: Cells<'a, u8>,
     /// Per domain row, one bit per occupancy word: 0 where the word holds
     /// no particle for sure.
-    pub words: &'a mut [u64],
+    pub words: Cells<'a, u64>,
 }
 
 /// What the sweep hands each occupied block to.
@@ -124,7 +128,7 @@ pub(crate) trait BlockSink {
     const CELLS: usize;
     /// The planes the sweep reads and the summaries it keeps, read between
     /// visits.
-    fn index(&mut self) -> Index<'_>;
+    fn index(&self) -> Index<'_>;
     /// Processes block `bx` of `row`, whose lowest corner has x `x0` and
     /// whose cells holding a particle are the set bits of `occ` (bit `c` for
     /// cell `c`, never a cell beyond a face).
@@ -200,7 +204,24 @@ impl Partition {
         }
     }
 
-    /// Visits every block holding a particle, forward (x fastest) or in
+    /// The rows of blocks of the step, numbered `by + cy bz`.
+    pub fn block_rows(&self) -> usize {
+        self.axes[1].blocks * self.axes[2].blocks
+    }
+
+    /// Task `i` of `count` of a parallel step (M11): a band of consecutive
+    /// rows of blocks, the bands of `0..count` covering every row once.
+    /// Rows of blocks share no domain row, so tasks share no element of any
+    /// plane the step writes (see [`Cells`]).
+    #[cfg(target_has_atomic = "8")]
+    pub fn band(&self, i: usize, count: usize) -> Range<usize> {
+        let total = self.block_rows();
+        let edge = |i: usize| (i as u64 * total as u64 / count as u64) as usize;
+        edge(i)..edge(i + 1)
+    }
+
+    /// Visits every block holding a particle in the rows of blocks of
+    /// `band` (all of them: `0..block_rows()`), forward (x fastest) or in
     /// exactly the reverse order. Blocks are independent (M3), so both orders
     /// leave the same world; the tests check it.
     ///
@@ -210,15 +231,20 @@ impl Partition {
     ///
     /// With `skip` false every row and word is swept, whatever the
     /// summaries say (the tests' reference).
-    pub fn sweep<S: BlockSink>(&self, sink: &mut S, reverse: bool, skip: bool) {
+    ///
+    /// The flags and summaries of rows outside the band are neither read
+    /// nor written, so bands can be swept at the same time (M11).
+    pub fn sweep_band<S: BlockSink>(&self, sink: &mut S, band: Range<usize>, reverse: bool, skip: bool) {
         let [ax, ay, az] = self.axes;
         let layers = if self.dim == 3 { 2 } else { 1 };
-        let total = ay.blocks * az.blocks;
+        let total = band.len();
         let mut j = 0;
         while j < total {
-            let i = if reverse { total - 1 - j } else { j };
+            let i = if reverse { band.end - 1 - j } else { band.start + j };
             let (by, bz) = (i % ay.blocks, i / ay.blocks);
-            let run = if skip { self.empty_run(sink.index().rows, by, bz, reverse) } else { 0 };
+            // Rows of blocks from i to the band's edge, i included.
+            let room = if reverse { i - band.start + 1 } else { band.end - i };
+            let run = if skip { self.empty_run(sink.index().rows, by, bz, reverse, room) } else { 0 };
             if run > 0 {
                 j += run;
                 continue;
@@ -240,7 +266,7 @@ impl Partition {
                     row.line[r] = line;
                     row.word[r] = line * self.row_words;
                     row.cell[r] = line * ax.n;
-                    flagged |= sink.index().rows[line] != 0;
+                    flagged |= sink.index().rows.get(line) != 0;
                 }
             }
             if flagged || !skip {
@@ -250,16 +276,17 @@ impl Partition {
     }
 
     /// How many rows of blocks from (`by`, `bz`) on (back from it in
-    /// reverse), all in one layer of blocks and away from the faces, hold
-    /// no particle for sure: a multiple of four, their rows read eight flags
-    /// at a time, at most 32.
+    /// reverse), all in one layer of blocks, away from the faces and among
+    /// the `room` rows of blocks left in the band, hold no particle for
+    /// sure: a multiple of four, their rows read eight flags at a time, at
+    /// most 32.
     #[inline]
-    fn empty_run(&self, rows: &[u8], by: usize, bz: usize, reverse: bool) -> usize {
+    fn empty_run(&self, rows: Cells<'_, u8>, by: usize, bz: usize, reverse: bool, room: usize) -> usize {
         let [_, ay, az] = self.axes;
         let (zs, z_out) = self.axis_pair(2, az.first + 2 * bz as isize);
         let layers = if self.dim == 3 { 2 } else { 1 };
         let mut run = 0;
-        while run < 32 {
+        while run < 32 && run + 4 <= room {
             // The four rows of blocks from `low` to `low + 3`.
             let low = if reverse { by.checked_sub(run + 3) } else { Some(by + run).filter(|&b| b + 4 <= ay.blocks) };
             let Some(low) = low else { break };
@@ -269,7 +296,7 @@ impl Partition {
             }
             let empty = (0..layers).all(|dz| {
                 let at = zs[dz] * ay.n + y as usize;
-                z_out >> dz & 1 != 0 || rows[at..at + 8] == [0; 8]
+                z_out >> dz & 1 != 0 || rows.window::<8>(at) == [0; 8]
             });
             if !empty {
                 break;
@@ -282,11 +309,11 @@ impl Partition {
     /// Word `w` of each domain row of a row of blocks (0 for a row beyond
     /// a face), block row `r` in element `r`.
     #[inline]
-    fn words<const ROWS: usize>(occ: &[u64], row: &BlockRow, w: usize) -> [u64; ROWS] {
+    fn words<const ROWS: usize>(occ: Cells<'_, u64>, row: &BlockRow, w: usize) -> [u64; ROWS] {
         let mut m = [0; ROWS];
         for (r, m) in m.iter_mut().enumerate() {
             if row.outside >> (2 * r) & 1 == 0 {
-                *m = occ[row.word[r] + w];
+                *m = occ.get(row.word[r] + w);
             }
         }
         m
@@ -319,7 +346,7 @@ impl Partition {
             bits
         };
         // Summary word k of the row's domain rows, OR-ed.
-        let summary = |idx: &Index<'_>, k: usize| (0..ROWS).filter(|&r| inside(r)).fold(0, |s, r| s | idx.words[row.line[r] * sw + k]);
+        let summary = |idx: &Index<'_>, k: usize| (0..ROWS).filter(|&r| inside(r)).fold(0, |s, r| s | idx.words.get(row.line[r] * sw + k));
         // Offset 1, not periodic: the half block (-1, 0) has block index 0,
         // its cell 1 in bit 0 of each row, and the pairs after it start at
         // index 1.
@@ -335,7 +362,7 @@ impl Partition {
         // row a word with a particle is seen in, and by the blocks for every
         // row a particle moves into.
         for r in (0..ROWS).filter(|&r| inside(r)) {
-            sink.index().rows[row.line[r]] = 0;
+            sink.index().rows.set(row.line[r], 0);
         }
         let mut seen = [0u64; ROWS];
         if half && !reverse {
@@ -377,7 +404,8 @@ impl Partition {
                     seen[r] |= m[r];
                     if m[r] == 0 {
                         // Swept and empty: the summary says so from now on.
-                        idx.words[row.line[r] * sw + k] &= !(1u64 << b);
+                        let at = row.line[r] * sw + k;
+                        idx.words.set(at, idx.words.get(at) & !(1u64 << b));
                     }
                 }
                 if self.offset == 1 {
@@ -410,7 +438,7 @@ impl Partition {
             half_block(sink);
         }
         for r in (0..ROWS).filter(|&r| inside(r) && seen[r] != 0) {
-            sink.index().rows[row.line[r]] = 1;
+            sink.index().rows.set(row.line[r], 1);
         }
     }
 }

@@ -31,7 +31,7 @@ macro_rules! with_quant {
 pub(crate) use with_quant;
 
 /// A stored velocity component type.
-pub(crate) trait Quant: Copy + Default + crate::layout::Plain + 'static {
+pub(crate) trait Quant: Copy + Default + Send + crate::layout::Plain + 'static {
     /// Stored steps per unit speed.
     const SCALE: f32;
     fn from_int(q: i32) -> Self;

@@ -7,6 +7,7 @@
 //! are compile-time parameters of [`Kernel`], so a scene pays nothing in its
 //! inner loop for the parts it does not use.
 
+use crate::cells::Cells;
 use crate::layout::Layout;
 use crate::force::ForceTerms;
 use crate::kernel::{Kernel, Shared, Writable};
@@ -14,6 +15,8 @@ use crate::partition::Partition;
 use crate::quant::Quant;
 use crate::rng::StepKey;
 use crate::layout::{groups, Planes};
+#[cfg(target_has_atomic = "8")]
+use crate::tasks::Host;
 use crate::world::{Counters, World};
 
 /// The block order of a step. Blocks are independent (M3, M8); the reverse
@@ -25,6 +28,13 @@ pub enum Order {
     /// Exactly the reverse.
     Reverse,
 }
+
+/// A step's split into tasks: the most tasks and the host that runs them
+/// (M11); `None` sweeps on the caller's thread.
+#[cfg(target_has_atomic = "8")]
+type Split<'h> = Option<(usize, Host<'h>)>;
+#[cfg(not(target_has_atomic = "8"))]
+type Split<'h> = Option<(usize, core::marker::PhantomData<&'h ()>)>;
 
 /// How a step visits its blocks: in which order, and whether blocks of a
 /// plain world may take the lean routine.
@@ -64,13 +74,72 @@ impl World {
         self.step_routed(Route { reverse: false, lean: false, skip: false });
     }
 
+    /// Advances one step split into at most `max_tasks` tasks (M11, at
+    /// most [`crate::MAX_TASKS`]) that `host` runs: it is called once, as
+    /// `host(count, task)`, and must call `task(i)` once for each `i` in
+    /// `0..count`, in any order and on any threads, returning after every
+    /// call has returned. The world is the one [`World::step`] gives, bit
+    /// for bit, whatever the count, the order or the threads.
+    ///
+    /// A task called twice does nothing the second time, and a task the
+    /// host did not call runs on this thread before the step ends.
+    ///
+    /// ```
+    /// use mpca::{Description, World};
+    ///
+    /// let desc = Description::new_2d(64, 64);
+    /// let mut memory = vec![0u8; mpca::world_bytes(&desc).unwrap()];
+    /// let world = World::init(&desc, &mut memory).unwrap();
+    /// world.add_particle([3, 4, 0], [0.5, 0.0, 0.0]).unwrap();
+    /// // The simplest host: a loop. A thread pool would spread the calls.
+    /// world.step_parallel(4, &mut |count, task| (0..count).for_each(task));
+    /// assert_eq!(world.stats().step, 1);
+    /// ```
+    #[cfg(target_has_atomic = "8")]
+    pub fn step_parallel(&mut self, max_tasks: usize, host: Host<'_>) {
+        self.step_split(Route { reverse: false, lean: true, skip: true }, Some((max_tasks, host)));
+    }
+
+    /// Advances `n` steps on `threads` threads of the standard library
+    /// (feature `std`): [`World::step_parallel`] with scoped threads that
+    /// take tasks as they finish others, four tasks a thread.
+    #[cfg(feature = "std")]
+    pub fn step_threads(&mut self, n: u64, threads: usize) {
+        use core::sync::atomic::{AtomicUsize, Ordering};
+        let threads = threads.max(1);
+        let mut host = |count: usize, task: &(dyn Fn(usize) + Sync)| {
+            let next = AtomicUsize::new(0);
+            let work = || loop {
+                let i = next.fetch_add(1, Ordering::Relaxed);
+                if i >= count {
+                    break;
+                }
+                task(i);
+            };
+            std::thread::scope(|s| {
+                for _ in 1..threads.min(count) {
+                    s.spawn(work);
+                }
+                work();
+            });
+        };
+        for _ in 0..n {
+            self.step_parallel(4 * threads, &mut host);
+        }
+    }
+
     fn step_routed(&mut self, route: Route) {
+        self.step_split(route, None);
+    }
+
+    /// One step, its sweep run whole or, with `split`, as tasks (M11).
+    fn step_split(&mut self, route: Route, split: Split<'_>) {
         self.emit();
         crate::quant::with_quant!(self.head.desc.quantization, Q => {
             match self.head.desc.dim {
                 #[cfg(feature = "dim3")]
-                3 => with_force::<Q, 3, 8>(self, route),
-                _ => with_force::<Q, 2, 4>(self, route),
+                3 => with_force::<Q, 3, 8>(self, route, split),
+                _ => with_force::<Q, 2, 4>(self, route, split),
             }
         });
         self.head.step += 1;
@@ -115,15 +184,18 @@ impl World {
             moves: crate::quant::move_table_8(desc.drift),
             plain: route.lean && !desc.per_particle_mass && !desc.lifetimes,
         };
-        let c = visit(&shared, Writable { occupancy, rows, words, velocity: groups(velocity), mass_index, life }, route.reverse);
+        let planes = Writable {
+            occupancy: Cells::new(occupancy),
+            rows: Cells::new(rows),
+            words: Cells::new(words),
+            velocity: Cells::new(groups(velocity)),
+            mass_index: Cells::new(mass_index),
+            life: Cells::new(life),
+        };
+        let c = visit(&shared, planes, route.reverse);
         let h = &mut head.counters;
-        h.exited += c.exited;
-        h.expired += c.expired;
+        h.add_step(&c);
         h.particles -= c.exited + c.expired;
-        h.collisions += c.collisions;
-        h.clamps += c.clamps;
-        h.clamp_energy = h.clamp_energy.saturating_add(c.clamp_energy);
-        h.displaced += c.displaced;
         h.processed = c.processed;
         h.skipped = part.total_blocks() - c.processed;
     }
@@ -131,18 +203,25 @@ impl World {
 
 /// Picks the force path (M9): fields, potentials and the vortex are summed
 /// per particle; a uniform force alone is one precomputed change.
-fn with_force<Q: Quant, const D: usize, const CELLS: usize>(w: &mut World, route: Route) {
+fn with_force<Q: Quant, const D: usize, const CELLS: usize>(w: &mut World, route: Route, split: Split<'_>) {
     #[cfg(feature = "fields")]
     if w.head.desc.forces.any_field() {
-        return run::<Q, D, CELLS, true>(w, route);
+        return run::<Q, D, CELLS, true>(w, route, split);
     }
-    run::<Q, D, CELLS, false>(w, route)
+    run::<Q, D, CELLS, false>(w, route, split)
 }
 
-fn run<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool>(w: &mut World, route: Route) {
+fn run<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool>(w: &mut World, route: Route, split: Split<'_>) {
     w.sweep_with::<Q, D>(route, |shared, planes, reverse| {
-        let mut kernel = Kernel::<Q, D, CELLS, GENERAL> { shared, planes, counters: Counters::default() };
-        shared.part.sweep(&mut kernel, reverse, route.skip);
-        kernel.counters
+        let sweep = |band| {
+            let mut kernel = Kernel::<Q, D, CELLS, GENERAL> { shared, planes, counters: Counters::default() };
+            shared.part.sweep_band(&mut kernel, band, reverse, route.skip);
+            kernel.counters
+        };
+        match split {
+            #[cfg(target_has_atomic = "8")]
+            Some((max, host)) => crate::tasks::run(&shared.part, max, host, &sweep),
+            _ => sweep(0..shared.part.block_rows()),
+        }
     });
 }

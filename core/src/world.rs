@@ -29,6 +29,19 @@ pub(crate) struct Counters {
     pub skipped: u64,
 }
 
+impl Counters {
+    /// Adds what a sweep of blocks counts (a task's share of a step).
+    pub fn add_step(&mut self, c: &Counters) {
+        self.exited += c.exited;
+        self.expired += c.expired;
+        self.collisions += c.collisions;
+        self.clamps += c.clamps;
+        self.clamp_energy = self.clamp_energy.saturating_add(c.clamp_energy);
+        self.displaced += c.displaced;
+        self.processed += c.processed;
+    }
+}
+
 /// 2^32, the scale of the clamped-energy accumulator.
 pub(crate) const ENERGY_SCALE: f64 = 4_294_967_296.0;
 

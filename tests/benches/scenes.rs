@@ -9,10 +9,14 @@
 //! runs one scene only, e.g. under `valgrind --tool=callgrind`; the last
 //! column, the blocks processed over the run, is what
 //! `scripts/instructions.sh` divides the step's instructions by.
+//!
+//! The parallel case (M11, `MPCA_BENCH_SCENE=parallel`) steps the 1024^2
+//! gas serially, as tasks on one thread, and on two threads.
 
 use std::time::Instant;
 
-use mpca_tests::scenes::{build, paper_scenes, size_scenes, Scene};
+use mpca::World;
+use mpca_tests::scenes::{build, paper_scenes, size_scenes, wide_gas, Scene};
 
 /// One scene's timing: the median and spread of `runs` runs, and what the
 /// last run did.
@@ -25,13 +29,21 @@ struct Timing {
 }
 
 fn time(scene: &Scene, runs: usize, memory: &mut Vec<u8>) -> Timing {
+    time_with(scene, runs, memory, &mut |w| w.step(1))
+}
+
+/// Takes one step of a world.
+type Stepper<'a> = &'a mut dyn FnMut(&mut World);
+
+/// [`time`] with each step taken by `step`.
+fn time_with(scene: &Scene, runs: usize, memory: &mut Vec<u8>, step: Stepper<'_>) -> Timing {
     let mut t = Timing { times: Vec::with_capacity(runs), processed: 0, total: 0, particles: 0, bytes_per_cell: 0.0 };
     for _ in 0..runs {
         let world = build(scene, memory).expect("scene builds");
         let (mut p, mut all) = (0u64, 0u64);
         let start = Instant::now();
         for _ in 0..scene.steps {
-            world.step(1);
+            step(world);
             let (done, skipped) = world.last_step_blocks();
             p += done;
             all += done + skipped;
@@ -84,5 +96,35 @@ fn main() {
         for (name, t) in per_step.iter().filter(|(n, _)| n.starts_with("gas-") || n.starts_with("empty-")) {
             println!("{name:<12} {:>10.1} us {:>8.3}x", t * 1e6, t / base);
         }
+    }
+    if only.as_deref().is_none_or(|n| n == "parallel") {
+        parallel(runs, &mut memory);
+    }
+}
+
+/// The parallel step against the serial one on the 1024^2 gas, from one
+/// run: the plain step, the split step on the calling thread (its overhead)
+/// and on two threads (its speed-up).
+fn parallel(runs: usize, memory: &mut Vec<u8>) {
+    let scene = wide_gas();
+    let one_thread = |w: &mut World| w.step_parallel(8, &mut |count, task| (0..count).for_each(task));
+    let cases: [(&str, Stepper<'_>); 3] =
+        [("step", &mut |w| w.step(1)), ("tasks, 1 thread", &mut { one_thread }), ("tasks, 2 threads", &mut |w| w.step_threads(1, 2))];
+    println!("\nparallel step, {} ({} steps), median of {runs} runs:", scene.name, scene.steps);
+    let mut base = 0.0;
+    for (name, step) in cases {
+        let t = time_with(&scene, runs, memory, step);
+        let median = t.times[runs / 2];
+        if base == 0.0 {
+            base = median;
+        }
+        println!(
+            "{name:<18} {:>9} particles {:>9.2} ms/step ({:.2}..{:.2}) {:>7.3}x the step",
+            t.particles,
+            median * 1e3 / scene.steps as f64,
+            t.times[0] * 1e3 / scene.steps as f64,
+            t.times[runs - 1] * 1e3 / scene.steps as f64,
+            base / median
+        );
     }
 }

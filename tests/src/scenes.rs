@@ -157,6 +157,16 @@ pub fn size_scenes() -> [Scene; 4] {
     [gas("gas-128", 128), gas("gas-1024", 1024), gas("gas-4096", 4096), empty]
 }
 
+/// The parallel step's benchmark and test world (issue 9): the aggregation
+/// gas over the whole of a periodic 1024 x 1024 world, about 315,000
+/// particles.
+pub fn wide_gas() -> Scene {
+    let mut desc = Description::new_2d(1024, 1024);
+    desc.restitution = 0.5;
+    desc.seed = 43;
+    Scene { name: "gas-1024-full", section: "-", desc, steps: 50, paper_seconds: f64::NAN, setup: |w| fill_gas(w, 1024, 1024) }
+}
+
 /// All four, in the paper's order.
 pub fn paper_scenes() -> [Scene; 4] {
     [aggregation(), cluster(), smoke(), water()]
