@@ -308,6 +308,33 @@ typedef uint32_t mpca_method;
 #endif // __cplusplus
 
 /**
+ * How a collision picks its direction (M5.2). Values of
+ * `mpca_desc.collisions`.
+ */
+enum mpca_collisions
+#if defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+  : uint32_t
+#endif // defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+ {
+  /**
+   * The paper's: a uniform direction; a speed above 1 is clamped.
+   */
+  MPCA_COLLISIONS_PAPER = 0,
+  /**
+   * M5.2b: a uniform direction among those that leave both speeds at
+   * most 1, so collisions keep their energy (e = 1) and never clamp.
+   */
+  MPCA_COLLISIONS_SPEED_LIMITED = 1,
+};
+#ifndef __cplusplus
+#if __STDC_VERSION__ >= 202311L
+typedef enum mpca_collisions mpca_collisions;
+#else
+typedef uint32_t mpca_collisions;
+#endif // __STDC_VERSION__ >= 202311L
+#endif // __cplusplus
+
+/**
  * Bits of `mpca_desc.forces` (M5.1); the force is the sum of those set.
  */
 enum mpca_force
@@ -473,6 +500,10 @@ typedef struct mpca_desc {
    * 1: particles carry a lifetime, so emitters can give them one.
    */
   uint32_t lifetimes;
+  /**
+   * An `mpca_collisions` value.
+   */
+  uint32_t collisions;
 } mpca_desc;
 
 /**
@@ -646,8 +677,8 @@ mpca_status mpca_debug_panic(void);
 /**
  * Fills `out` with the defaults for a `dim`-dimensional world of
  * `nx x ny (x nz)` cells: periodic faces, one mass of 1, no obstacles, no
- * force, e = 1, dt = 1, seed 0, 8-bit velocities, the paper's drift rule,
- * the exact-fast assignment, no emitters. Sets `struct_size`. Sizes are
+ * force, e = 1, dt = 1, seed 0, 8-bit velocities, the paper's drift rule
+ * and collisions, the exact-fast assignment, no emitters. Sets `struct_size`. Sizes are
  * checked later, by mpca_world_bytes and mpca_world_init.
  */
 mpca_status mpca_desc_defaults(struct mpca_desc *out,

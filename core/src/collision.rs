@@ -1,7 +1,7 @@
 //! Particle-particle collision (M5.2, eqs. 7-8).
 
 use crate::rng::Stream;
-use crate::vector::dot;
+use crate::vector::{dot, normalise};
 
 /// Cell pairs of a block, in a fixed order: `PAIRS_2D` has the C(4,2) = 6
 /// pairs of a 2D block, `PAIRS_3D` the C(8,2) = 28 of a 3D one. M5.2 picks
@@ -120,6 +120,38 @@ pub(crate) fn collide_pair(va: [f32; 3], vb: [f32; 3], (sa, sb): (f32, f32), e: 
     (a, b)
 }
 
+/// M5.2b: eqs. 7-8 with `R` uniform among the directions for which both
+/// outgoing speeds are at most `limit` (in the velocities' unit), by
+/// drawing `R` again until they are. Such directions always exist: `R`
+/// along `va - vb` gives each particle a weighted mean of the two incoming
+/// velocities (`(sa + sb e) va + sb (1 - e) vb` for `a`), no faster than
+/// the faster of them. After [`SPEED_LIMIT_TRIES`] refused draws (a set of
+/// admissible directions too small to hit), that direction is taken.
+#[inline]
+pub(crate) fn collide_limited<const D: usize>(
+    va: [f32; 3],
+    vb: [f32; 3],
+    s: (f32, f32),
+    e: f32,
+    limit: f32,
+    rng: &mut Stream,
+) -> ([f32; 3], [f32; 3]) {
+    let fits = |v: [f32; 3]| dot(v, v) <= limit * limit;
+    for _ in 0..SPEED_LIMIT_TRIES {
+        let (a, b) = collide_pair(va, vb, s, e, random_unit::<D>(rng));
+        if fits(a) && fits(b) {
+            return (a, b);
+        }
+    }
+    let rel = [va[0] - vb[0], va[1] - vb[1], va[2] - vb[2]];
+    // rel = 0 leaves both at V0 whatever R is; an axis will do.
+    collide_pair(va, vb, s, e, normalise(rel).unwrap_or([1.0, 0.0, 0.0]))
+}
+
+/// Draws of `R` M5.2b makes before it takes the direction of the relative
+/// velocity.
+pub(crate) const SPEED_LIMIT_TRIES: u32 = 16;
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -163,6 +195,31 @@ mod tests {
                 let p0 = ma * va[k] + mb * vb[k];
                 let p1 = ma * a[k] + mb * b[k];
                 assert!((p0 - p1).abs() < 1e-6, "momentum {p0} {p1}");
+                rel_before += (va[k] - vb[k]) * (va[k] - vb[k]);
+                rel_after += (a[k] - b[k]) * (a[k] - b[k]);
+            }
+            assert!((libm::sqrtf(rel_after) - e * libm::sqrtf(rel_before)).abs() < 1e-5);
+        }
+    }
+
+    #[test]
+    fn speed_limited_collisions_stay_below_the_limit_and_keep_momentum() {
+        // Expect: outgoing speeds <= 1 for any incoming pair at or below 1,
+        // momentum as eqs. 7-8 keep it, the relative speed scaled by e; and
+        // for a pair whose admissible directions are a sliver (both fast,
+        // nearly parallel, e = 1) the fallback still fits.
+        let mut rng = block_stream(12, 0, 0);
+        let fits = |v: [f32; 3]| dot(v, v) <= 1.0;
+        for i in 0..4000 {
+            let v = |rng: &mut Stream| random_unit::<3>(rng).map(|c| c * rng.unit());
+            let (va, vb) = if i % 4 == 0 { ([0.99, 0.1, 0.0], [0.99, -0.12, 0.0]) } else { (v(&mut rng), v(&mut rng)) };
+            let (ma, mb) = (1.0 + (i % 3) as f32, 1.0);
+            let e = [1.0, 0.5, 0.9][i % 3];
+            let (a, b) = collide_limited::<3>(va, vb, shares(ma, mb), e, 1.0, &mut rng);
+            assert!(fits(a) && fits(b), "{va:?} {vb:?} -> {a:?} {b:?}");
+            let (mut rel_before, mut rel_after) = (0.0, 0.0);
+            for k in 0..3 {
+                assert!((ma * va[k] + mb * vb[k] - ma * a[k] - mb * b[k]).abs() < 1e-5);
                 rel_before += (va[k] - vb[k]) * (va[k] - vb[k]);
                 rel_after += (a[k] - b[k]) * (a[k] - b[k]);
             }

@@ -41,6 +41,19 @@ pub enum Drift {
     Calibrated = 1,
 }
 
+/// How a collision picks its direction `R` (M5.2).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[repr(u8)]
+pub enum Collisions {
+    /// The paper's: `R` uniform. Eqs. 7-8 can then give a speed above 1,
+    /// which the clamp (M5.5) cuts, losing energy.
+    Paper = 0,
+    /// M5.2b (beyond the paper): `R` uniform among the directions for which
+    /// both outgoing speeds are at most 1, so a collision never needs the
+    /// clamp and keeps momentum and the `e`-scaled energy.
+    SpeedLimited = 1,
+}
+
 /// The force terms a world sums in M5.1. Uniform acceleration needs no
 /// storage; the other three need the `fields` feature.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -121,6 +134,8 @@ pub struct Description {
     pub drift: Drift,
     /// The move assignment method.
     pub method: Method,
+    /// How collisions pick their direction.
+    pub collisions: Collisions,
     /// How many emitters fit.
     pub emitter_capacity: u32,
     /// Whether particles carry a remaining lifetime (a `u16` per cell), so
@@ -131,7 +146,7 @@ pub struct Description {
 impl Description {
     /// A 2D world of `nx x ny` cells: periodic on every axis, one mass of 1,
     /// no obstacles, no force, `e = 1`, `dt = 1`, 8-bit velocities, the
-    /// paper's drift rule and the exact-fast assignment.
+    /// paper's drift rule and collisions, and the exact-fast assignment.
     pub const fn new_2d(nx: u32, ny: u32) -> Self {
         Description {
             dim: 2,
@@ -152,6 +167,7 @@ impl Description {
             quantization: Quantization::Bits8,
             drift: Drift::Paper,
             method: Method::ExactFast,
+            collisions: Collisions::Paper,
             emitter_capacity: 0,
             lifetimes: false,
         }

@@ -36,8 +36,8 @@
 
 use crate::assign::{assign_moves, optimal_moves_2d, pick_move, Method, MoveProblem, PLACE_2D};
 use crate::cells::Cells;
-use crate::collision::{block_pairs, collide_pair, pair_holds_two, random_unit, shares};
-use crate::desc::Description;
+use crate::collision::{block_pairs, collide_limited, collide_pair, pair_holds_two, random_unit, shares};
+use crate::desc::{Collisions, Description};
 use crate::force::ForceTerms;
 use crate::obstacle::{reflect, surface_at, Surface};
 use crate::partition::{cells_at, resolve, BlockRow, BlockSink, Beyond, Index, Partition};
@@ -92,6 +92,10 @@ pub(crate) struct Kernel<'a, Q, const D: usize, const CELLS: usize, const GENERA
     pub planes: Writable<'a, Q, D>,
     pub counters: Counters,
 }
+
+/// `sqrt(D)` quanta for D = 2, 3: the most stochastic rounding can add to a
+/// speed.
+const ROUNDING_MARGIN: [f32; 2] = [core::f32::consts::SQRT_2, 1.732_050_8];
 
 /// Per 2D blocked mask, the part of the table key its cells contribute
 /// (digit 1 each, M5.6).
@@ -338,10 +342,15 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
         }
         let (a, c) = pairs[p as usize];
         let (a, c) = (usize::from(a), usize::from(c));
-        let r = random_unit::<D>(rng);
         let (ma, mc) = (mass(a), mass(c));
         let s = if equal { (0.5, 0.5) } else { shares(ma, mc) };
-        let (mut xa, mut xc) = collide_pair(b.velocity(a), b.velocity(c), s, self.shared.desc.restitution, r);
+        let (va, vc, e) = (b.velocity(a), b.velocity(c), self.shared.desc.restitution);
+        let (mut xa, mut xc) = match self.shared.desc.collisions {
+            Collisions::Paper => collide_pair(va, vc, s, e, random_unit::<D>(rng)),
+            // Below the limit by sqrt(D) quanta, so that rounding (less than a
+            // quantum per component) cannot store a speed above 1 either.
+            Collisions::SpeedLimited => collide_limited::<D>(va, vc, s, e, Q::SCALE - ROUNDING_MARGIN[D - 2], rng),
+        };
         self.counters.collisions += 1;
         clamp_counted(&mut xa, Q::SCALE, ma, &mut self.counters);
         clamp_counted(&mut xc, Q::SCALE, mc, &mut self.counters);

@@ -1,6 +1,6 @@
 //! `mpca_desc`: the scene description (M9), as C sees it.
 
-use mpca_core::{Boundary, Description, Drift, Forces, Method, Quantization, Vortex};
+use mpca_core::{Boundary, Collisions, Description, Drift, Forces, Method, Quantization, Vortex};
 
 use crate::{check_size, flag, guard, mpca_status, read, write};
 
@@ -36,6 +36,18 @@ pub enum mpca_method {
     ExactFast = 1,
     /// The paper's 3D approximation: fastest particles choose first.
     Greedy = 2,
+}
+
+/// How a collision picks its direction (M5.2). Values of
+/// `mpca_desc.collisions`.
+#[repr(u32)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum mpca_collisions {
+    /// The paper's: a uniform direction; a speed above 1 is clamped.
+    Paper = 0,
+    /// M5.2b: a uniform direction among those that leave both speeds at
+    /// most 1, so collisions keep their energy (e = 1) and never clamp.
+    SpeedLimited = 1,
 }
 
 /// Bits of `mpca_desc.forces` (M5.1); the force is the sum of those set.
@@ -103,6 +115,8 @@ pub struct mpca_desc {
     pub emitter_capacity: u32,
     /// 1: particles carry a lifetime, so emitters can give them one.
     pub lifetimes: u32,
+    /// An `mpca_collisions` value.
+    pub collisions: u32,
 }
 
 const FORCE_BITS: u32 = mpca_force::Uniform as u32 | mpca_force::Field as u32 | mpca_force::Potential as u32 | mpca_force::Vortex as u32;
@@ -159,6 +173,7 @@ impl mpca_desc {
             method: d.method as u32,
             emitter_capacity: d.emitter_capacity,
             lifetimes: u32::from(d.lifetimes),
+            collisions: d.collisions as u32,
         }
     }
 
@@ -210,6 +225,11 @@ impl mpca_desc {
             2 => Method::Greedy,
             _ => return Err(mpca_status::BadEnum),
         };
+        d.collisions = match self.collisions {
+            0 => Collisions::Paper,
+            1 => Collisions::SpeedLimited,
+            _ => return Err(mpca_status::BadEnum),
+        };
         d.emitter_capacity = self.emitter_capacity;
         d.lifetimes = flag(self.lifetimes)?;
         Ok(d)
@@ -218,8 +238,8 @@ impl mpca_desc {
 
 /// Fills `out` with the defaults for a `dim`-dimensional world of
 /// `nx x ny (x nz)` cells: periodic faces, one mass of 1, no obstacles, no
-/// force, e = 1, dt = 1, seed 0, 8-bit velocities, the paper's drift rule,
-/// the exact-fast assignment, no emitters. Sets `struct_size`. Sizes are
+/// force, e = 1, dt = 1, seed 0, 8-bit velocities, the paper's drift rule
+/// and collisions, the exact-fast assignment, no emitters. Sets `struct_size`. Sizes are
 /// checked later, by mpca_world_bytes and mpca_world_init.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_desc_defaults(out: *mut mpca_desc, dim: u32, nx: u32, ny: u32, nz: u32) -> mpca_status {

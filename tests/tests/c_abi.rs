@@ -25,7 +25,7 @@ use std::sync::OnceLock;
 
 use clib::{library, root};
 
-use mpca::{Boundary, Description, Drift, Emitter, Method, Quantization, Shape, Stats, World, WorldBox};
+use mpca::{Boundary, Collisions, Description, Drift, Emitter, Method, Quantization, Shape, Stats, World, WorldBox};
 
 /// Error cases `errors.c` must try. It tries 1,795 today; the margin is
 /// for cases merged or reworded, not for groups dropped.
@@ -555,6 +555,7 @@ fn scene_3d() -> (u64, Stats) {
     d.quantization = Quantization::Bits16;
     d.drift = Drift::Calibrated;
     d.method = Method::Greedy;
+    d.collisions = Collisions::SpeedLimited;
     let mut w = WorldBox::new(&d).unwrap(); // as mpca_world_create
 
     let centre = [S3_SPHERE_X, S3_SPHERE_Y, S3_SPHERE_Z];

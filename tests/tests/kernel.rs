@@ -10,7 +10,7 @@
 
 mod common;
 
-use mpca::{Boundary, Description, Drift, Emitter, Method, Quantization, Shape, World};
+use mpca::{Boundary, Collisions, Description, Drift, Emitter, Method, Quantization, Shape, World};
 
 /// A plain world: a gas at density `density` with speeds up to `speed`.
 fn gas<'a>(desc: &Description, density: f32, speed: f32, seed: u64, memory: &'a mut Vec<u8>) -> &'a mut World {
@@ -36,7 +36,7 @@ fn gas<'a>(desc: &Description, density: f32, speed: f32, seed: u64, memory: &'a 
 /// Every plain setting: 2D and 3D; periodic, walled and open faces (whose
 /// half blocks take the general routine in both runs); no force and
 /// gravity; with and without an obstacle; both widths, both drift rules,
-/// all three methods.
+/// all three methods, both collision rules.
 fn settings() -> Vec<Description> {
     let mut out = vec![];
     for dim in [2u32, 3] {
@@ -48,6 +48,7 @@ fn settings() -> Vec<Description> {
                 d.drift = [Drift::Paper, Drift::Calibrated][variant / 2];
                 d.method = [Method::ExactFast, Method::Greedy, Method::Exhaustive][(variant + i) % 3];
                 d.restitution = [1.0, 0.6, 0.0][i];
+                d.collisions = [Collisions::Paper, Collisions::SpeedLimited][(variant + i) % 2];
                 if variant % 2 == 1 {
                     d.forces.uniform = true;
                     d.gravity = [0.004, -0.03, 0.01];
@@ -68,7 +69,10 @@ fn settings() -> Vec<Description> {
 fn lean_routine_equals_the_general_one_bit_for_bit() {
     let (mut a, mut b) = (Vec::new(), Vec::new());
     for (n, desc) in settings().iter().enumerate() {
-        let what = format!("setting {n}: {}D {:?} {:?} {:?} {:?}", desc.dim, desc.boundary[0][0], desc.quantization, desc.drift, desc.method);
+        let what = format!(
+            "setting {n}: {}D {:?} {:?} {:?} {:?} {:?}",
+            desc.dim, desc.boundary[0][0], desc.quantization, desc.drift, desc.method, desc.collisions
+        );
         let lean = gas(desc, 0.35, 0.9, n as u64, &mut a);
         let general = gas(desc, 0.35, 0.9, n as u64, &mut b);
         same_as_reference(lean, general, 40, &what);
