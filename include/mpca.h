@@ -504,6 +504,11 @@ typedef struct mpca_desc {
    * An `mpca_collisions` value.
    */
   uint32_t collisions;
+  /**
+   * 1: a particle refused the cell it wanted meets the particle holding
+   * it, head on (M5.7), so piles come to rest. 0: the paper's rules.
+   */
+  uint32_t contacts;
 } mpca_desc;
 
 /**

@@ -136,6 +136,11 @@ pub struct Description {
     pub method: Method,
     /// How collisions pick their direction.
     pub collisions: Collisions,
+    /// M5.7 (beyond the paper): a particle refused the cell it wanted meets
+    /// the particle that holds it, head on, with restitution `e`, so piles
+    /// come to rest. Off: the paper's rules, where a refused particle keeps
+    /// its velocity.
+    pub contacts: bool,
     /// How many emitters fit.
     pub emitter_capacity: u32,
     /// Whether particles carry a remaining lifetime (a `u16` per cell), so
@@ -168,6 +173,7 @@ impl Description {
             drift: Drift::Paper,
             method: Method::ExactFast,
             collisions: Collisions::Paper,
+            contacts: false,
             emitter_capacity: 0,
             lifetimes: false,
         }

@@ -30,7 +30,9 @@
 //!    block along some axis, 16 bits per axis (32 bits, then 16 in 3D), and
 //!    after a reflection one 64-bit output for rounding the reflected
 //!    velocity;
-//! 4. M5.6, the tie-break of the assignment, where there is a choice.
+//! 4. M5.6, the tie-break of the assignment, where there is a choice;
+//! 5. M1 after M5.7's contacts (when on), per particle in cell order whose
+//!    velocity a contact changed, one 64-bit output for its rounding.
 //!
 //! M5.1 draws nothing.
 
@@ -457,6 +459,36 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
         targets
     }
 
+    /// M5.7: every particle refused the cell it wanted (`want`, by the
+    /// assignment's `targets`) meets the particle that holds that cell,
+    /// in the order of the refused particles' cells: eqs. 7-8 with `R` from
+    /// the wanted cell back towards the refused particle's, if it was
+    /// closing in, then the clamp. `mass` gives a cell's mass, by the cell
+    /// the particle started in.
+    #[inline(always)]
+    fn contacts(&mut self, b: &mut Block<D, CELLS>, want: &[u8; CELLS], targets: u32, mass: impl Fn(usize) -> f32, equal: bool) {
+        for a in cells_of(b.occ) {
+            let wanted = a ^ usize::from(want[a]);
+            if want[a] == 0 || (targets >> (4 * a) & 7) as usize == wanted {
+                continue;
+            }
+            // The particle placed in the wanted cell, if any.
+            let Some(h) = cells_of(b.occ).find(|&h| (targets >> (4 * h) & 7) as usize == wanted) else { continue };
+            let r = back_normal::<D>(a, wanted);
+            let (xa, xh) = (b.velocity(a), b.velocity(h));
+            if dot([xa[0] - xh[0], xa[1] - xh[1], xa[2] - xh[2]], r) >= 0.0 {
+                continue;
+            }
+            let (ma, mh) = (mass(a), mass(h));
+            let s = if equal { (0.5, 0.5) } else { shares(ma, mh) };
+            let (mut ya, mut yh) = collide_pair(xa, xh, s, self.shared.desc.restitution, r);
+            clamp_counted(&mut ya, Q::SCALE, ma, &mut self.counters);
+            clamp_counted(&mut yh, Q::SCALE, mh, &mut self.counters);
+            b.set(a, ya);
+            b.set(h, yh);
+        }
+    }
+
     /// Writes the velocity of the particle of cell `c` to cell `to` of the
     /// planes.
     #[inline(always)]
@@ -507,6 +539,10 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
             }
         });
         let targets = self.assign(&b, 0, &want, wanted, key, &mut rng);
+        if sh.desc.contacts && wanted != 0 {
+            self.contacts(&mut b, &want, targets, |_| mass, true);
+            b.round::<Q>(&mut rng);
+        }
         self.counters.processed += 1;
         if (targets ^ IDENTITY) & FIELDS[usize::from(occ)] == 0 && b.dirty == 0 {
             return;
@@ -614,6 +650,12 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
 
         // M5.6 move.
         let targets = self.assign(&b, blocked, &want, wanted, key, &mut rng);
+
+        // M5.7 contacts, then M1 for what they changed.
+        if desc.contacts && wanted != 0 {
+            self.contacts(&mut b, &want, targets, |c| mass[c], !desc.per_particle_mass);
+            b.round::<Q>(&mut rng);
+        }
 
         // Write back what changed.
         self.counters.processed += 1;

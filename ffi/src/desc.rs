@@ -117,6 +117,9 @@ pub struct mpca_desc {
     pub lifetimes: u32,
     /// An `mpca_collisions` value.
     pub collisions: u32,
+    /// 1: a particle refused the cell it wanted meets the particle holding
+    /// it, head on (M5.7), so piles come to rest. 0: the paper's rules.
+    pub contacts: u32,
 }
 
 const FORCE_BITS: u32 = mpca_force::Uniform as u32 | mpca_force::Field as u32 | mpca_force::Potential as u32 | mpca_force::Vortex as u32;
@@ -174,6 +177,7 @@ impl mpca_desc {
             emitter_capacity: d.emitter_capacity,
             lifetimes: u32::from(d.lifetimes),
             collisions: d.collisions as u32,
+            contacts: u32::from(d.contacts),
         }
     }
 
@@ -230,6 +234,7 @@ impl mpca_desc {
             1 => Collisions::SpeedLimited,
             _ => return Err(mpca_status::BadEnum),
         };
+        d.contacts = flag(self.contacts)?;
         d.emitter_capacity = self.emitter_capacity;
         d.lifetimes = flag(self.lifetimes)?;
         Ok(d)

@@ -382,6 +382,7 @@ static void description_cases(void) {
         DESC_VALUES(base, drift, MPCA_STATUS_BAD_ENUM, 2, UINT32_MAX);
         DESC_VALUES(base, method, MPCA_STATUS_BAD_ENUM, 3, UINT32_MAX);
         DESC_VALUES(base, collisions, MPCA_STATUS_BAD_ENUM, 2, UINT32_MAX);
+        DESC_VALUES(base, contacts, MPCA_STATUS_BAD_ENUM, 2, UINT32_MAX);
         DESC_VALUES(base, mass_classes, MPCA_STATUS_CAPACITY_RANGE, 0, 257, UINT32_MAX);
 
         /* Every float field, the third gravity component in 2D included. */

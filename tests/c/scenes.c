@@ -273,6 +273,7 @@ static void scene_3d(void) {
     d.drift = MPCA_DRIFT_CALIBRATED;
     d.method = MPCA_METHOD_GREEDY;
     d.collisions = MPCA_COLLISIONS_SPEED_LIMITED;
+    d.contacts = 1;
     mpca_world *w = NULL;
     CHECK_OK(mpca_world_create(&d, &w));
     if (w == NULL) {

@@ -556,6 +556,7 @@ fn scene_3d() -> (u64, Stats) {
     d.drift = Drift::Calibrated;
     d.method = Method::Greedy;
     d.collisions = Collisions::SpeedLimited;
+    d.contacts = true;
     let mut w = WorldBox::new(&d).unwrap(); // as mpca_world_create
 
     let centre = [S3_SPHERE_X, S3_SPHERE_Y, S3_SPHERE_Z];

@@ -5,7 +5,7 @@
 
 mod common;
 
-use mpca::{Boundary, Description, Drift, Emitter, Method, Quantization, Shape, Stats, Vortex, World};
+use mpca::{Boundary, Collisions, Description, Drift, Emitter, Method, Quantization, Shape, Stats, Vortex, World};
 
 /// The boundary kinds a configuration can have.
 #[derive(Clone, Copy, Debug)]
@@ -49,6 +49,8 @@ fn description(dim: u32, faces: Faces, variant: usize) -> Description {
     desc.quantization = [Quantization::Bits8, Quantization::Bits16][variant % 2];
     desc.drift = [Drift::Paper, Drift::Calibrated][variant / 3 % 2];
     desc.method = [Method::ExactFast, Method::Greedy, Method::Exhaustive][variant % 3];
+    desc.collisions = [Collisions::Paper, Collisions::SpeedLimited][variant / 2 % 2];
+    desc.contacts = variant % 4 < 2;
     desc.seed = 0x5eed_0000 + variant as u64;
     desc
 }

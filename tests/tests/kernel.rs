@@ -36,7 +36,7 @@ fn gas<'a>(desc: &Description, density: f32, speed: f32, seed: u64, memory: &'a 
 /// Every plain setting: 2D and 3D; periodic, walled and open faces (whose
 /// half blocks take the general routine in both runs); no force and
 /// gravity; with and without an obstacle; both widths, both drift rules,
-/// all three methods, both collision rules.
+/// all three methods, both collision rules, with and without contacts.
 fn settings() -> Vec<Description> {
     let mut out = vec![];
     for dim in [2u32, 3] {
@@ -49,6 +49,7 @@ fn settings() -> Vec<Description> {
                 d.method = [Method::ExactFast, Method::Greedy, Method::Exhaustive][(variant + i) % 3];
                 d.restitution = [1.0, 0.6, 0.0][i];
                 d.collisions = [Collisions::Paper, Collisions::SpeedLimited][(variant + i) % 2];
+                d.contacts = (variant + i / 2) % 2 == 1;
                 if variant % 2 == 1 {
                     d.forces.uniform = true;
                     d.gravity = [0.004, -0.03, 0.01];
@@ -70,8 +71,8 @@ fn lean_routine_equals_the_general_one_bit_for_bit() {
     let (mut a, mut b) = (Vec::new(), Vec::new());
     for (n, desc) in settings().iter().enumerate() {
         let what = format!(
-            "setting {n}: {}D {:?} {:?} {:?} {:?} {:?}",
-            desc.dim, desc.boundary[0][0], desc.quantization, desc.drift, desc.method, desc.collisions
+            "setting {n}: {}D {:?} {:?} {:?} {:?} {:?} contacts {}",
+            desc.dim, desc.boundary[0][0], desc.quantization, desc.drift, desc.method, desc.collisions, desc.contacts
         );
         let lean = gas(desc, 0.35, 0.9, n as u64, &mut a);
         let general = gas(desc, 0.35, 0.9, n as u64, &mut b);
