@@ -3,8 +3,9 @@
  * (Ecchu, Takai, Sato 1993). The C ABI of the Rust crate mpca.
  *
  * Every function returns an mpca_status (MPCA_STATUS_OK = 0) and writes
- * results through out-parameters. NULL pointers, dead or forged handles, NaN
- * and out-of-range values are refused with a status and change nothing.
+ * results through out-parameters. NULL pointers, dead or forged handles
+ * (firmware builds: within the limits stated at mpca_world), NaN and
+ * out-of-range values are refused with a status and change nothing.
  * mpca_status_message() turns a status into a static string.
  *
  * Panics: in hosted builds every function runs inside a panic boundary and
@@ -370,9 +371,41 @@ typedef uint32_t mpca_cell_kind;
 #endif // __cplusplus
 
 /**
- * An opaque world. It lives in memory the caller handed to mpca_world_init
- * or that mpca_world_create allocated. (Not `repr(C)`, so cbindgen declares
- * it as an incomplete type.)
+ * An opaque world, reached through its handle: the `mpca_world *` that
+ * mpca_world_create or mpca_world_init wrote. A handle is only ever passed
+ * back to this library, never dereferenced. (Not `repr(C)`, so cbindgen
+ * declares it as an incomplete type.)
+ *
+ * Hosted builds (the default, with `std`): a handle is a value the library
+ * issues, not the world's address, and no value is issued twice in a
+ * process. The library keeps a registry of the live ones and asks it before
+ * it reads any memory, so every value that is not the handle of a live
+ * world is refused with `MPCA_STATUS_BAD_HANDLE` (NULL with
+ * `MPCA_STATUS_NULL_POINTER`) without a read: the handle of a destroyed or
+ * deinitialised world, even after its memory was freed or reused by the
+ * allocator or by a new world; the address of a world or of a copy of its
+ * bytes; any forged value. Building a world with mpca_world_init in memory
+ * that holds a live world ends that world: its handle is refused from then
+ * on. Where pointers are 32 bits wide the values run out after 2^32 - 1
+ * worlds in a process; create and init then return
+ * `MPCA_STATUS_OUT_OF_MEMORY`.
+ *
+ * Firmware builds (without `std`: no allocator, no registry): the handle
+ * is the world's address in the caller's memory, and the world's header
+ * holds a tag tied to that address, which mpca_world_deinit clears.
+ * Promised: NULL, and a value not aligned as a world's start, are refused
+ * without a read. Any other handle is read (the tag and the length after
+ * it: 16 bytes, 12 on 32-bit targets) and refused with
+ * `MPCA_STATUS_BAD_HANDLE` unless it holds the tag of a world built at
+ * exactly that address: so a deinitialised world whose memory is untouched
+ * since, a copy of a world's bytes at another address, and memory that
+ * never held a world are refused (bar a 2^-64 chance that such memory holds
+ * that very tag). Not promised: once the memory of a deinitialised world is
+ * freed or handed to anything else, passing its handle reads that memory,
+ * which is undefined behaviour if it is gone (as for any dangling pointer);
+ * and once mpca_world_init builds a new world at the same address, the old
+ * handle equals the new one and reaches the new world. End a world with
+ * mpca_world_deinit and drop its handle before the memory is reused.
  */
 typedef struct mpca_world mpca_world;
 
@@ -876,6 +909,8 @@ const char *mpca_status_message(uint32_t status);
  * mpca_world_bytes) and writes its handle to `out_world`. Nothing is
  * allocated. The world stays valid until mpca_world_deinit or until the
  * memory is freed or reused; do not move or copy the memory meanwhile.
+ * A world built over a live one ends it (see `mpca_world` for what its
+ * handle then does).
  */
 mpca_status mpca_world_init(const struct mpca_desc *desc,
                             void *memory,
@@ -883,8 +918,8 @@ mpca_status mpca_world_init(const struct mpca_desc *desc,
                             struct mpca_world **out_world);
 
 /**
- * Marks a world made by mpca_world_init as ended, so its handle is refused
- * from now on; the caller then frees or reuses the memory. A world made by
+ * Ends a world made by mpca_world_init, so its handle is refused from now
+ * on; the caller then frees or reuses the memory. A world made by
  * mpca_world_create is refused with `MPCA_STATUS_BAD_HANDLE`: destroy it.
  */
 mpca_status mpca_world_deinit(struct mpca_world *world);

@@ -5,11 +5,12 @@
 //!
 //! - **NULL** for any pointer argument returns `MPCA_STATUS_NULL_POINTER`;
 //!   nothing is dereferenced first.
-//! - **Handles** carry a tag tied to their address, cleared by
-//!   `mpca_world_destroy` / `mpca_world_deinit`; a destroyed, deinitialised
-//!   or forged handle returns `MPCA_STATUS_BAD_HANDLE`. Worlds from
-//!   `mpca_world_create` are also kept in a registry, so a destroyed one is
-//!   refused without its freed memory being read.
+//! - **Handles** (`handle.rs`): in hosted builds a value the library issues
+//!   once and looks up in a registry of live worlds before reading any
+//!   memory, so a destroyed, deinitialised or forged handle returns
+//!   `MPCA_STATUS_BAD_HANDLE` whatever became of the memory. Firmware
+//!   builds have no registry: the handle is the world's address, checked by
+//!   a tag tied to it, with the limits `mpca_world` documents.
 //! - **Bad values** (NaN, infinities, out-of-range numbers, unknown enum
 //!   values, wrong `struct_size`) return a status and leave the world
 //!   unchanged.
@@ -30,6 +31,7 @@ extern crate std;
 mod desc;
 mod emitters;
 mod forces;
+mod handle;
 mod obstacles;
 mod particles;
 mod status;

@@ -564,16 +564,26 @@ static void handle_cases(void) {
     memset(forged, SENTINEL_BYTE, 8192);
     handle_sweep((mpca_world *)(void *)forged, MPCA_STATUS_BAD_HANDLE, "forged, garbage memory");
 
-    /* A byte-for-byte copy of a live world elsewhere: the tag is tied to
-     * the address, so the copy is not a world. */
-    size_t offset = (size_t)((unsigned char *)full2 - full2_memory);
-    unsigned char *copy_raw = malloc(full2_bytes + 5 + 128);
+    /* A byte-for-byte copy of a live world elsewhere is not a world, and
+     * neither is the live world's own memory: a handle is what
+     * mpca_world_init returned, not an address. Every 8-byte aligned
+     * address where a world could start in either (it starts within the
+     * first 5 + 64 bytes: 5 of misalignment, then the alignment slack). */
+    unsigned char *copy_raw = malloc(full2_bytes + 5 + 64);
     CHECK(copy_raw != NULL);
-    unsigned char *copy_handle = align64(copy_raw + offset) + 64;
-    memcpy(copy_handle - offset, full2_memory, full2_bytes + 5);
-    handle_sweep((mpca_world *)(void *)copy_handle, MPCA_STATUS_BAD_HANDLE, "a copy of a live world");
+    unsigned char *copy = align64(copy_raw);
+    memcpy(copy, full2_memory, full2_bytes + 5);
+    for (size_t offset = 0; offset < 5 + 64; offset++) {
+        if ((uintptr_t)(copy + offset) % 8 == 0) {
+            handle_sweep((mpca_world *)(void *)(copy + offset), MPCA_STATUS_BAD_HANDLE, "a copy of a live world");
+        }
+        if ((uintptr_t)(full2_memory + offset) % 8 == 0) {
+            handle_sweep((mpca_world *)(void *)(full2_memory + offset), MPCA_STATUS_BAD_HANDLE,
+                         "the memory of a live world");
+        }
+    }
 
-    /* Pointers into a live world: misaligned, and aligned but not its start. */
+    /* Near a live handle: misaligned, and aligned but not the handle. */
     handle_sweep((mpca_world *)(void *)((unsigned char *)full2 + 8), MPCA_STATUS_BAD_HANDLE, "live world + 8");
     handle_sweep((mpca_world *)(void *)((unsigned char *)full2 + 64), MPCA_STATUS_BAD_HANDLE, "live world + 64");
 
@@ -588,6 +598,21 @@ static void handle_cases(void) {
     CHECK_OK(mpca_world_init(&d, memory, bytes, &w));
     CHECK_OK(mpca_world_deinit(w));
     handle_sweep(w, MPCA_STATUS_BAD_HANDLE, "deinitialised");
+
+    /* Deinitialised, its memory then freed: refused without a read of the
+     * freed memory. 512 x 512 cells, so that free gives the block back to
+     * the system and a read of it faults (ASan reports any size). */
+    mpca_desc big;
+    size_t big_bytes = 0;
+    CHECK_OK(mpca_desc_defaults(&big, 2, 512, 512, 0));
+    CHECK_OK(mpca_world_bytes(&big, &big_bytes));
+    unsigned char *big_memory = malloc(big_bytes);
+    CHECK(big_memory != NULL);
+    mpca_world *gone = NULL;
+    CHECK_OK(mpca_world_init(&big, big_memory, big_bytes, &gone));
+    CHECK_OK(mpca_world_deinit(gone));
+    free(big_memory);
+    handle_sweep(gone, MPCA_STATUS_BAD_HANDLE, "deinitialised, memory freed");
 
     /* Destroyed, and destroyed twice (the sweep ends with a second
      * mpca_world_destroy). No world is created between the destroy and the

@@ -7,7 +7,8 @@
 //! - `scenes.c` (linked dynamically): a 2D and a 3D scene stepped from C,
 //!   whose hashes and statistics must equal those of the same scenes built
 //!   here through the Rust API; the exports against the cells.
-//! - `reuse.c`: caller memory at the address of a destroyed world.
+//! - `reuse.c`: handles after their worlds end, while the allocator and
+//!   the caller reuse the memory those worlds lived in.
 //! - `header_only.c`: `include/mpca.h` alone, as C99 and as C++11.
 //!
 //! With `MPCA_C_SANITIZE=1` every program is built with AddressSanitizer
@@ -223,9 +224,14 @@ fn scenes() -> &'static Run {
 
 fn reuse() -> &'static Run {
     static RUN: OnceLock<Run> = OnceLock::new();
-    // Without its quarantine ASan hands freed blocks back, as glibc does.
+    // Without its quarantine ASan hands freed blocks back, as glibc does;
+    // without its fill of new blocks they keep what they held, by which
+    // reuse.c knows the block of a destroyed world.
     RUN.get_or_init(|| {
-        run(build("reuse", &["reuse.c", "check.c"], Link::Shared), ":quarantine_size_mb=0:thread_local_quarantine_size_kb=0")
+        run(
+            build("reuse", &["reuse.c", "check.c"], Link::Shared),
+            ":quarantine_size_mb=0:thread_local_quarantine_size_kb=0:max_malloc_fill_size=0",
+        )
     })
 }
 
@@ -654,6 +660,32 @@ fn caller_memory_at_a_destroyed_worlds_address_is_a_live_world() {
     // Else the check never ran: the allocator must hand the block back.
     assert_eq!(run.value("reuse: "), "reached", "the allocator never reused the destroyed world's block");
     run.assert_success();
+}
+
+/// `create(&a); destroy(a); create(&b)`, 200 times: the allocator hands b
+/// the block a had, and `a` must reach nothing (it reached b every time
+/// while a handle was the world's address).
+#[test]
+fn destroyed_handles_stay_dead_when_the_allocator_reuses_their_block() {
+    let run = reuse();
+    assert_eq!(run.value("destroyed handles that reached a world: "), "0 of 200");
+    run.assert_no_failures_in("destroyed handles while the allocator reuses blocks");
+}
+
+#[test]
+fn no_handle_value_is_handed_out_twice() {
+    let run = reuse();
+    assert_eq!(run.value("handle values repeated: "), "0 of 400");
+    run.assert_no_failures_in("handle values are never reused");
+}
+
+/// `init(m); deinit; init(m)`, and `init(m)` twice without a deinit: the
+/// earlier handle is refused, the new world works.
+#[test]
+fn handles_of_worlds_in_reused_caller_memory_stay_dead() {
+    let run = reuse();
+    run.assert_no_failures_in("deinitialised handles while the caller reuses memory");
+    run.assert_no_failures_in("a world whose memory mpca_world_init reused");
 }
 
 /// The README's C example (its first ```c block), compiled with the same
