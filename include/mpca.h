@@ -196,11 +196,13 @@ enum mpca_status
    */
   MPCA_STATUS_BAD_SHAPE = 127,
   /**
-   * The output resolution or buffer length is wrong.
+   * The output resolution or buffer length is wrong (a length over
+   * PTRDIFF_MAX bytes included).
    */
   MPCA_STATUS_BAD_RESOLUTION = 128,
   /**
-   * A per-cell input has the wrong length.
+   * A length is wrong: a per-cell input not of the world's cell count, or
+   * more bytes than an object can have (over PTRDIFF_MAX).
    */
   MPCA_STATUS_BAD_LENGTH = 129,
   /**
@@ -906,7 +908,8 @@ const char *mpca_status_message(uint32_t status);
 
 /**
  * Builds an empty world in `memory` (`len` bytes, any alignment, at least
- * mpca_world_bytes) and writes its handle to `out_world`. Nothing is
+ * mpca_world_bytes; more than PTRDIFF_MAX is refused with
+ * `MPCA_STATUS_BAD_LENGTH`) and writes its handle to `out_world`. Nothing is
  * allocated. The world stays valid until mpca_world_deinit or until the
  * memory is freed or reused; do not move or copy the memory meanwhile.
  * A world built over a live one ends it (see `mpca_world` for what its

@@ -22,7 +22,7 @@ pub unsafe extern "C" fn mpca_world_set_gravity(world: *mut mpca_world, g: *cons
 pub unsafe extern "C" fn mpca_world_set_force_field(world: *mut mpca_world, forces: *const f32, len: usize) -> mpca_status {
     guard(|| {
         let w = unsafe { world_mut(world)? };
-        Ok(w.set_force_field(unsafe { slice(forces, len)? })?)
+        Ok(w.set_force_field(unsafe { slice(forces, len, mpca_status::BadLength)? })?)
     })
 }
 
@@ -41,7 +41,7 @@ pub unsafe extern "C" fn mpca_world_set_cell_force(world: *mut mpca_world, pos: 
 pub unsafe extern "C" fn mpca_world_set_potential(world: *mut mpca_world, u: *const f32, len: usize) -> mpca_status {
     guard(|| {
         let w = unsafe { world_mut(world)? };
-        Ok(w.set_potential(unsafe { slice(u, len)? })?)
+        Ok(w.set_potential(unsafe { slice(u, len, mpca_status::BadLength)? })?)
     })
 }
 

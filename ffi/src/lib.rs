@@ -114,23 +114,39 @@ pub(crate) unsafe fn array<T: Copy, const N: usize>(p: *const T) -> Result<[T; N
     Ok(core::array::from_fn(|i| unsafe { p.add(i).read() }))
 }
 
-/// A slice of `len` values at `p`; NULL is refused even when `len` is 0.
+/// Whether `len` values of `T` fit in one object: at most `isize::MAX`
+/// bytes, the bound `core::slice::from_raw_parts` requires.
 #[inline]
-pub(crate) unsafe fn slice<'a, T>(p: *const T, len: usize) -> Result<&'a [T], mpca_status> {
+fn fits<T>(len: usize) -> bool {
+    len <= isize::MAX as usize / core::mem::size_of::<T>().max(1)
+}
+
+/// A slice of `len` values at `p`; NULL is refused even when `len` is 0, and
+/// a length no object can have with `too_long`, before any slice is formed.
+#[inline]
+pub(crate) unsafe fn slice<'a, T>(p: *const T, len: usize, too_long: mpca_status) -> Result<&'a [T], mpca_status> {
     if p.is_null() {
         return Err(mpca_status::NullPointer);
     }
-    // SAFETY: the C contract: `p` points at `len` readable values.
+    if !fits::<T>(len) {
+        return Err(too_long);
+    }
+    // SAFETY: not NULL, and `len` values span at most isize::MAX bytes;
+    // the C contract: `p` points at `len` readable values.
     Ok(unsafe { core::slice::from_raw_parts(p, len) })
 }
 
-/// A mutable slice of `len` values at `p`; NULL is refused.
+/// A mutable slice of `len` values at `p`; NULL and lengths no object can
+/// have are refused, as in [`slice`].
 #[inline]
-pub(crate) unsafe fn slice_mut<'a, T>(p: *mut T, len: usize) -> Result<&'a mut [T], mpca_status> {
+pub(crate) unsafe fn slice_mut<'a, T>(p: *mut T, len: usize, too_long: mpca_status) -> Result<&'a mut [T], mpca_status> {
     if p.is_null() {
         return Err(mpca_status::NullPointer);
     }
-    // SAFETY: the C contract: `p` points at `len` writable values.
+    if !fits::<T>(len) {
+        return Err(too_long);
+    }
+    // SAFETY: as in `slice`, for `len` writable values.
     Ok(unsafe { core::slice::from_raw_parts_mut(p, len) })
 }
 

@@ -66,7 +66,7 @@ pub unsafe extern "C" fn mpca_world_add_sphere(world: *mut mpca_world, centre: *
 pub unsafe extern "C" fn mpca_world_add_obstacle_mask(world: *mut mpca_world, mask: *const u8, len: usize, e: f32) -> mpca_status {
     guard(|| {
         let w = unsafe { world_mut(world)? };
-        let mask = unsafe { slice(mask, len)? };
+        let mask = unsafe { slice(mask, len, mpca_status::BadLength)? };
         Ok(w.add_obstacle_mask(mask, e)?)
     })
 }

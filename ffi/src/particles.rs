@@ -134,7 +134,8 @@ unsafe fn export(
         if capacity < n {
             return Err(mpca_status::OutputTooSmall);
         }
-        let dst = unsafe { slice_mut(out, n * per)? };
+        let floats = n.checked_mul(per).ok_or(mpca_status::OutputTooSmall)?;
+        let dst = unsafe { slice_mut(out, floats, mpca_status::OutputTooSmall)? };
         for (p, chunk) in w.particles().zip(dst.chunks_exact_mut(per)) {
             put(&p, chunk);
         }
@@ -187,7 +188,7 @@ pub unsafe extern "C" fn mpca_world_density(world: *const mpca_world, res: *cons
     guard(|| {
         let w = unsafe { world_ref(world)? };
         let res = unsafe { array(res)? };
-        let out = unsafe { slice_mut(out, len)? };
+        let out = unsafe { slice_mut(out, len, mpca_status::BadResolution)? };
         Ok(w.density(res, out)?)
     })
 }
@@ -198,7 +199,7 @@ pub unsafe extern "C" fn mpca_world_density_u8(world: *const mpca_world, res: *c
     guard(|| {
         let w = unsafe { world_ref(world)? };
         let res = unsafe { array(res)? };
-        let out = unsafe { slice_mut(out, len)? };
+        let out = unsafe { slice_mut(out, len, mpca_status::BadResolution)? };
         Ok(w.density_u8(res, out)?)
     })
 }

@@ -64,7 +64,8 @@ pub(crate) unsafe fn world_ref<'a>(w: *const mpca_world) -> Result<&'a World, mp
 }
 
 /// Builds an empty world in `memory` (`len` bytes, any alignment, at least
-/// mpca_world_bytes) and writes its handle to `out_world`. Nothing is
+/// mpca_world_bytes; more than PTRDIFF_MAX is refused with
+/// `MPCA_STATUS_BAD_LENGTH`) and writes its handle to `out_world`. Nothing is
 /// allocated. The world stays valid until mpca_world_deinit or until the
 /// memory is freed or reused; do not move or copy the memory meanwhile.
 /// A world built over a live one ends it (see `mpca_world` for what its
@@ -79,7 +80,7 @@ pub unsafe extern "C" fn mpca_world_init(
     guard(|| {
         let d = unsafe { read(desc)? }.to_core()?;
         let out = unsafe { write(out_world)? };
-        let bytes = unsafe { crate::slice_mut(memory.cast::<u8>(), len)? };
+        let bytes = unsafe { crate::slice_mut(memory.cast::<u8>(), len, mpca_status::BadLength)? };
         let number = handle::reserve()?;
         let world = World::init(&d, bytes)?;
         *out = handle::issue(number, world);

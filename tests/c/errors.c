@@ -491,6 +491,14 @@ static void memory_cases(void) {
     }
     /* Some offset in 64 needs the full slack. */
     CHECK(refused_short > 0);
+
+    /* Lengths no buffer can have (more than PTRDIFF_MAX bytes). */
+    set_context("mpca_world_init with a length beyond PTRDIFF_MAX");
+    mpca_world *w = NULL;
+    memset(pool, SENTINEL_BYTE, POOL_BYTES);
+    REFUSED(MPCA_STATUS_BAD_LENGTH, mpca_world_init(&d, pool, SIZE_MAX, &w));
+    REFUSED(MPCA_STATUS_BAD_LENGTH, mpca_world_init(&d, pool, (size_t)PTRDIFF_MAX + 1, &w));
+    CHECK(w == NULL && pool[0] == SENTINEL_BYTE && pool[POOL_BYTES - 1] == SENTINEL_BYTE);
 }
 
 /* --- Handles ----------------------------------------------------------- */
@@ -851,6 +859,11 @@ static void force_cases(void) {
         REFUSED(MPCA_STATUS_BAD_LENGTH, mpca_world_set_force_field(w, field, 0));
         REFUSED(MPCA_STATUS_BAD_LENGTH, mpca_world_set_potential(w, potential, cells - 1));
         REFUSED(MPCA_STATUS_BAD_LENGTH, mpca_world_set_potential(w, potential, 0));
+        /* Lengths no array can have (more than PTRDIFF_MAX bytes). */
+        REFUSED(MPCA_STATUS_BAD_LENGTH, mpca_world_set_force_field(w, field, SIZE_MAX));
+        REFUSED(MPCA_STATUS_BAD_LENGTH, mpca_world_set_force_field(w, field, (size_t)PTRDIFF_MAX / sizeof(float) + 1));
+        REFUSED(MPCA_STATUS_BAD_LENGTH, mpca_world_set_potential(w, potential, SIZE_MAX));
+        REFUSED(MPCA_STATUS_BAD_LENGTH, mpca_world_set_potential(w, potential, (size_t)PTRDIFF_MAX / sizeof(float) + 1));
         EACH_OUTSIDE(pos, dim, n, mpca_world_set_cell_force(w, pos, f));
         EACH_OUTSIDE(pos, dim, n, mpca_world_set_cell_potential(w, pos, u));
     }
@@ -931,6 +944,8 @@ static void obstacle_cases(void) {
     REFUSED(MPCA_STATUS_BAD_LENGTH, mpca_world_add_obstacle_mask(full2, mask2, CELLS2 - 1, e));
     REFUSED(MPCA_STATUS_BAD_LENGTH, mpca_world_add_obstacle_mask(full2, mask2, CELLS2 + 1, e));
     REFUSED(MPCA_STATUS_BAD_LENGTH, mpca_world_add_obstacle_mask(full3, mask3, CELLS3 - 1, e));
+    REFUSED(MPCA_STATUS_BAD_LENGTH, mpca_world_add_obstacle_mask(full2, mask2, SIZE_MAX, e));
+    REFUSED(MPCA_STATUS_BAD_LENGTH, mpca_world_add_obstacle_mask(full2, mask2, (size_t)PTRDIFF_MAX + 1, e));
     /* A wall one cell thick across the world: free on both sides, so the
      * normal of its inner cells vanishes (M7). */
     unsigned char wall[CELLS2] = {0};
@@ -1086,6 +1101,11 @@ static void output_cases(void) {
         REFUSED(MPCA_STATUS_BAD_RESOLUTION, mpca_world_density(full2, res, out, lens[at]));
         REFUSED(MPCA_STATUS_BAD_RESOLUTION, mpca_world_density_u8(full2, res, bytes, lens[at]));
     }
+    set_context("density buffers longer than PTRDIFF_MAX bytes");
+    REFUSED(MPCA_STATUS_BAD_RESOLUTION, mpca_world_density(full2, res, out, SIZE_MAX));
+    REFUSED(MPCA_STATUS_BAD_RESOLUTION, mpca_world_density(full2, res, out, (size_t)PTRDIFF_MAX / sizeof(float) + 1));
+    REFUSED(MPCA_STATUS_BAD_RESOLUTION, mpca_world_density_u8(full2, res, bytes, SIZE_MAX));
+    REFUSED(MPCA_STATUS_BAD_RESOLUTION, mpca_world_density_u8(full2, res, bytes, (size_t)PTRDIFF_MAX + 1));
 
     set_context("statistics struct_size");
     const uint32_t sizes[4] = {0, sizeof(mpca_stats) - 8, sizeof(mpca_stats) + 8, UINT32_MAX};
