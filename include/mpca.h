@@ -764,6 +764,8 @@ mpca_status mpca_world_add_obstacle(struct mpca_world *world,
 /**
  * Every cell whose centre lies on the far side of the plane through `point`
  * with outward `normal` (3 values each): a floor when the normal points up.
+ * In 2D only the x and y of `normal` count, as for mpca_world_add_obstacle;
+ * a normal with neither is refused (`MPCA_STATUS_BAD_SHAPE`).
  */
 mpca_status mpca_world_add_half_space(struct mpca_world *world,
                                       const float *point,

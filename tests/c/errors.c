@@ -929,6 +929,7 @@ static void obstacle_cases(void) {
     float zero[3] = {0, 0, 0}, z_only[3] = {0, 0, 1};
     REFUSED(MPCA_STATUS_UNDEFINED_NORMAL, mpca_world_add_obstacle(full2, cell2, zero, e));
     REFUSED(MPCA_STATUS_UNDEFINED_NORMAL, mpca_world_add_obstacle(full2, cell2, z_only, e)); /* no z in 2D */
+    REFUSED(MPCA_STATUS_BAD_SHAPE, mpca_world_add_half_space(full2, point, z_only, e));       /* nor here */
     REFUSED(MPCA_STATUS_UNDEFINED_NORMAL, mpca_world_add_obstacle(full3, cell3, zero, e));
     REFUSED(MPCA_STATUS_BAD_SHAPE, mpca_world_add_half_space(full2, point, zero, e));
     REFUSED(MPCA_STATUS_BAD_SHAPE, mpca_world_add_half_space(full3, point, zero, e));

@@ -9,6 +9,8 @@
 //!   here through the Rust API; the exports against the cells.
 //! - `reuse.c`: handles after their worlds end, while the allocator and
 //!   the caller reuse the memory those worlds lived in.
+//! - `edges.c` (linked statically): inputs at the edges of the model, judged
+//!   by what the world then does: 2D half-space normals.
 //! - `header_only.c`: `include/mpca.h` alone, as C99 and as C++11.
 //!
 //! With `MPCA_C_SANITIZE=1` every program is built with AddressSanitizer
@@ -210,8 +212,9 @@ fn run(exe: PathBuf, asan_options: &str) -> Run {
     run
 }
 
-/// The runs of `errors.c` (static), `scenes.c` (shared) and `reuse.c`
-/// (shared), each built and run once per test process.
+/// The runs of `errors.c` (static), `scenes.c` (shared), `reuse.c`
+/// (shared) and `edges.c` (static), each built and run once per test
+/// process.
 fn errors() -> &'static Run {
     static RUN: OnceLock<Run> = OnceLock::new();
     RUN.get_or_init(|| run(build("errors", &["errors.c", "check.c"], Link::Static), ""))
@@ -233,6 +236,11 @@ fn reuse() -> &'static Run {
             ":quarantine_size_mb=0:thread_local_quarantine_size_kb=0:max_malloc_fill_size=0",
         )
     })
+}
+
+fn edges() -> &'static Run {
+    static RUN: OnceLock<Run> = OnceLock::new();
+    RUN.get_or_init(|| run(build("edges", &["edges.c", "check.c"], Link::Static), ""))
 }
 
 /// `include/mpca.h` without its comments.
@@ -636,7 +644,7 @@ fn exports_from_c_agree_with_the_cells_and_the_density() {
 
 #[test]
 fn sanitizers_are_linked_in_exactly_when_asked() {
-    for run in [errors(), scenes(), reuse()] {
+    for run in [errors(), scenes(), reuse(), edges()] {
         let printed = run.value("sanitizer: ");
         let needed = Elf::read(&run.exe).needed();
         let asan = needed.iter().any(|n| n.starts_with("libasan.so"));
@@ -686,6 +694,17 @@ fn handles_of_worlds_in_reused_caller_memory_stay_dead() {
     let run = reuse();
     run.assert_no_failures_in("deinitialised handles while the caller reuses memory");
     run.assert_no_failures_in("a world whose memory mpca_world_init reused");
+}
+
+// --- Inputs at the edges of the model ----------------------------------------
+
+/// A 2D half-space keeps only the x and y of its normal: (1, 0, 5) gives
+/// the surface normal (1, 0, 0), and a particle bounces off it.
+#[test]
+fn half_space_normals_in_2d_lie_in_the_plane() {
+    let run = edges();
+    run.value("half-space: ");
+    run.assert_no_failures_in("2D half-space normal");
 }
 
 /// The README's C example (its first ```c block), compiled with the same

@@ -1,0 +1,71 @@
+/*
+ * Inputs at the edges of the model, judged by what the world then does
+ * (errors.c judges the refusals):
+ *
+ * - a 2D half-space takes only the x and y of its normal, as
+ *   mpca_world_add_obstacle does: a normal (1, 0, 5) is the wall x <= c
+ *   with normal (1, 0, 0), off which a particle bounces.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "check.h"
+
+/* The one particle of `w`, its velocity into `v`; 0 if not exactly one. */
+static int only_particle(mpca_world *w, float pos[3], float v[3]) {
+    size_t n = 0;
+    CHECK_OK(mpca_world_particle_count(w, &n));
+    if (n != 1) {
+        return 0;
+    }
+    CHECK_OK(mpca_world_export_positions(w, pos, 1, &n));
+    CHECK_OK(mpca_world_export_velocities(w, v, 1, &n));
+    return 1;
+}
+
+/* --- Half-spaces in 2D --------------------------------------------------- */
+
+static void half_space_in_2d(void) {
+    check_context = "2D half-space normal";
+    mpca_desc d;
+    CHECK_OK(mpca_desc_defaults(&d, 2, 16, 16, 0));
+    d.boundary[0][0] = d.boundary[0][1] = MPCA_BOUNDARY_WALL;
+    d.obstacles = 1;
+    d.surface_capacity = 64;
+    d.seed = 5;
+    mpca_world *w = NULL;
+    CHECK_OK(mpca_world_create(&d, &w));
+    /* The cells whose centres have x <= 4: columns 0 to 3. */
+    float point[3] = {4, 0, 0}, normal[3] = {1, 0, 5};
+    CHECK_OK(mpca_world_add_half_space(w, point, normal, 1.0f));
+    for (uint32_t y = 0; y < 16; y++) {
+        uint32_t wall[3] = {3, y, 0}, free_cell[3] = {4, y, 0};
+        float n[3] = {0, 0, 0}, e = 0;
+        mpca_cell c;
+        CHECK_OK(mpca_world_surface(w, wall, n, &e));
+        CHECK(n[0] == 1 && n[1] == 0 && n[2] == 0 && e == 1);
+        CHECK_OK(mpca_world_cell(w, free_cell, &c));
+        CHECK(c.kind == MPCA_CELL_KIND_EMPTY);
+    }
+    /* A particle flying at it bounces: its x velocity turns positive. */
+    uint32_t pos[3] = {6, 8, 0};
+    float v0[3] = {-0.5f, 0, 0}, at[3], v[3];
+    CHECK_OK(mpca_world_add_particle(w, pos, v0));
+    float most = -1;
+    for (unsigned t = 0; t < 60; t++) {
+        CHECK_OK(mpca_world_step(w, 1));
+        CHECK(only_particle(w, at, v));
+        CHECK(at[0] > 4); /* never inside the wall */
+        most = v[0] > most ? v[0] : most;
+    }
+    CHECK(most > 0.4f);
+    printf("half-space: x velocity after the bounce %.3f\n", (double)most);
+    CHECK_OK(mpca_world_destroy(w));
+}
+
+int main(void) {
+    check_begin();
+    half_space_in_2d();
+    return check_end();
+}
