@@ -744,7 +744,8 @@ mpca_status mpca_world_set_cell_potential(struct mpca_world *world, const uint32
 
 /**
  * Sets the Rankine vortex: centre (`cx`, `cy`), core radius and
- * circulation. Its axis is parallel to z in 3D.
+ * circulation. Its axis is parallel to z in 3D. The force is zero at the
+ * centre, however small the core.
  */
 mpca_status mpca_world_set_vortex(struct mpca_world *world,
                                   float cx,

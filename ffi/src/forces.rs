@@ -55,7 +55,8 @@ pub unsafe extern "C" fn mpca_world_set_cell_potential(world: *mut mpca_world, p
 }
 
 /// Sets the Rankine vortex: centre (`cx`, `cy`), core radius and
-/// circulation. Its axis is parallel to z in 3D.
+/// circulation. Its axis is parallel to z in 3D. The force is zero at the
+/// centre, however small the core.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_world_set_vortex(world: *mut mpca_world, cx: f32, cy: f32, core_radius: f32, circulation: f32) -> mpca_status {
     guard(|| {

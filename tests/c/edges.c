@@ -4,7 +4,10 @@
  *
  * - a 2D half-space takes only the x and y of its normal, as
  *   mpca_world_add_obstacle does: a normal (1, 0, 5) is the wall x <= c
- *   with normal (1, 0, 0), off which a particle bounces.
+ *   with normal (1, 0, 0), off which a particle bounces;
+ * - a Rankine vortex with a core too small to square in float exerts no
+ *   force at its centre (no 0 * inf), so a particle there keeps its
+ *   velocity, with or without circulation.
  */
 #include <math.h>
 #include <stdio.h>
@@ -64,8 +67,56 @@ static void half_space_in_2d(void) {
     CHECK_OK(mpca_world_destroy(w));
 }
 
+/* --- A vortex with a tiny core ---------------------------------------- */
+
+/* A particle at the vortex centre, moving along x: after one step (the
+ * force acts before the move) its stored velocity is what it was. */
+static void vortex_centre(uint32_t dim, float core, float circulation, int through_set) {
+    mpca_desc d;
+    CHECK_OK(mpca_desc_defaults(&d, dim, 8, 8, 8));
+    d.forces = MPCA_FORCE_VORTEX;
+    d.vortex_centre[0] = 4.5f; /* the centre of cell (4, 4) */
+    d.vortex_centre[1] = 4.5f;
+    d.vortex_core_radius = through_set ? 1.0f : core;
+    d.vortex_circulation = through_set ? 0.0f : circulation;
+    mpca_world *w = NULL;
+    CHECK_OK(mpca_world_create(&d, &w));
+    if (through_set) {
+        CHECK_OK(mpca_world_set_vortex(w, 4.5f, 4.5f, core, circulation));
+    }
+    uint32_t pos[3] = {4, 4, dim == 3 ? 4 : 0};
+    float v0[3] = {0.5f, 0, 0}, at[3], before[3], after[3];
+    mpca_cell c;
+    CHECK_OK(mpca_world_add_particle(w, pos, v0));
+    CHECK_OK(mpca_world_cell(w, pos, &c));
+    memcpy(before, c.particle.velocity, sizeof before);
+    CHECK_OK(mpca_world_step(w, 1));
+    CHECK(only_particle(w, at, after));
+    CHECK(after[0] == before[0] && after[1] == before[1] && after[2] == before[2]);
+    mpca_stats s;
+    memset(&s, 0, sizeof s);
+    s.struct_size = sizeof s;
+    CHECK_OK(mpca_world_stats(w, &s));
+    CHECK(s.clamps == 0);
+    printf("vortex %uD core %g circulation %g: velocity (%g, %g) after a step at its centre\n", dim, (double)core,
+           (double)circulation, (double)after[0], (double)after[1]);
+    CHECK_OK(mpca_world_destroy(w));
+}
+
+static void vortex_cases(void) {
+    check_context = "vortex with a tiny core";
+    for (uint32_t dim = 2; dim <= 3; dim++) {
+        for (int through_set = 0; through_set <= 1; through_set++) {
+            vortex_centre(dim, 1e-30f, 0.0f, through_set);
+            vortex_centre(dim, 1e-30f, 1.0f, through_set);
+            vortex_centre(dim, 1e-30f, -3e38f, through_set);
+        }
+    }
+}
+
 int main(void) {
     check_begin();
     half_space_in_2d();
+    vortex_cases();
     return check_end();
 }

@@ -10,7 +10,8 @@
 //! - `reuse.c`: handles after their worlds end, while the allocator and
 //!   the caller reuse the memory those worlds lived in.
 //! - `edges.c` (linked statically): inputs at the edges of the model, judged
-//!   by what the world then does: 2D half-space normals.
+//!   by what the world then does: 2D half-space normals, a vortex with a
+//!   tiny core.
 //! - `header_only.c`: `include/mpca.h` alone, as C99 and as C++11.
 //!
 //! With `MPCA_C_SANITIZE=1` every program is built with AddressSanitizer
@@ -705,6 +706,16 @@ fn half_space_normals_in_2d_lie_in_the_plane() {
     let run = edges();
     run.value("half-space: ");
     run.assert_no_failures_in("2D half-space normal");
+}
+
+/// A vortex whose core radius squares to zero in float: no force at its
+/// centre, so a particle there keeps its velocity (it was stopped by
+/// 0 * inf = NaN).
+#[test]
+fn a_vortex_with_a_tiny_core_exerts_no_force_at_its_centre() {
+    let run = edges();
+    assert_eq!(run.values("vortex ").len(), 12, "{}", run.stdout);
+    run.assert_no_failures_in("vortex with a tiny core");
 }
 
 /// The README's C example (its first ```c block), compiled with the same
