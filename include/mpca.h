@@ -822,15 +822,20 @@ mpca_status mpca_world_surface(const struct mpca_world *world,
 
 /**
  * Adds a particle of the world's mass at `pos` (3 values) with velocity
- * `velocity` (3 values; |v| <= 1; the third is ignored in 2D).
+ * `velocity` (3 values; the third is ignored in 2D), stored rounded to
+ * nearest. Accepted: components in [-1, 1] that round to a velocity the
+ * step itself can store, one within a quantum per axis (1/127 at 8 bits)
+ * of a velocity of length at most 1. That is every |v| <= 1 and every
+ * velocity mpca_world_cell and the exports report, so a world can be
+ * rebuilt from its own export; anything else is `MPCA_STATUS_SPEED_RANGE`.
  */
 mpca_status mpca_world_add_particle(struct mpca_world *world,
                                     const uint32_t *pos,
                                     const float *velocity);
 
 /**
- * Adds a particle of mass `mass`; worlds without per-particle masses accept
- * only their own mass.
+ * Adds a particle of mass `mass` (velocity as for mpca_world_add_particle);
+ * worlds without per-particle masses accept only their own mass.
  */
 mpca_status mpca_world_add_particle_mass(struct mpca_world *world,
                                          const uint32_t *pos,

@@ -11,7 +11,7 @@
 //!   the caller reuse the memory those worlds lived in.
 //! - `edges.c` (linked statically): inputs at the edges of the model, judged
 //!   by what the world then does: 2D half-space normals, a vortex with a
-//!   tiny core.
+//!   tiny core, a world rebuilt from its own export.
 //! - `header_only.c`: `include/mpca.h` alone, as C99 and as C++11.
 //!
 //! With `MPCA_C_SANITIZE=1` every program is built with AddressSanitizer
@@ -716,6 +716,21 @@ fn a_vortex_with_a_tiny_core_exerts_no_force_at_its_centre() {
     let run = edges();
     assert_eq!(run.values("vortex ").len(), 12, "{}", run.stdout);
     run.assert_no_failures_in("vortex with a tiny core");
+}
+
+/// Every particle `mpca_world_cell` reports is accepted back by
+/// `mpca_world_add_particle_mass`, and the rebuilt world hashes equal, for
+/// 2D and 3D, 8- and 16-bit velocities; and the case met velocities that
+/// rounding took above 1.
+#[test]
+fn a_world_rebuilds_from_its_own_export() {
+    let run = edges();
+    let lines = run.values("rebuild ");
+    assert_eq!(lines.len(), 8, "{}", run.stdout);
+    for line in &lines {
+        assert!(line.contains(" 0 refused"), "{line}");
+    }
+    run.assert_no_failures_in("a world rebuilt from its own export");
 }
 
 /// The README's C example (its first ```c block), compiled with the same
