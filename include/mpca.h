@@ -536,7 +536,8 @@ typedef struct mpca_emitter {
   float velocity[3];
   /**
    * Radius of a uniform random spread added to the velocity;
-   * |velocity| + spread <= 1.
+   * |velocity| + spread <= 1 (summed in double precision, so a sum above
+   * 1 by more than about 1e-16 is refused).
    */
   float spread;
   /**

@@ -761,6 +761,14 @@ static void emitter_cases(void) {
         x.velocity[1] = x.velocity[2] = 0;
         x.spread = 0.6f; /* |v| + spread > 1 */
         REFUSED(MPCA_STATUS_SPEED_RANGE, mpca_world_add_emitter(w, &x, &index));
+        /* |v| + spread above 1 by less than a float's spacing at 1: a sum
+         * in float rounds both to 1. */
+        x.spread = nextafterf(0.5f, 1.0f);
+        REFUSED(MPCA_STATUS_SPEED_RANGE, mpca_world_add_emitter(w, &x, &index));
+        x.velocity[0] = 0;
+        x.velocity[1] = 0.75f;
+        x.spread = nextafterf(0.25f, 1.0f);
+        REFUSED(MPCA_STATUS_SPEED_RANGE, mpca_world_add_emitter(w, &x, &index));
         x = e;
         x.lifetime = 65536;
         REFUSED(MPCA_STATUS_LIFETIME_RANGE, mpca_world_add_emitter(w, &x, &index));
