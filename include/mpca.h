@@ -3,8 +3,9 @@
  * (Ecchu, Takai, Sato 1993). The C ABI of the Rust crate mpca.
  *
  * Every function returns an mpca_status (MPCA_STATUS_OK = 0) and writes
- * results through out-parameters. NULL pointers, dead or forged handles, NaN
- * and out-of-range values are refused with a status and change nothing.
+ * results through out-parameters. NULL pointers, dead or forged handles
+ * (firmware builds: within the limits stated at mpca_world), NaN and
+ * out-of-range values are refused with a status and change nothing.
  * mpca_status_message() turns a status into a static string.
  *
  * Panics: in hosted builds every function runs inside a panic boundary and
@@ -195,11 +196,13 @@ enum mpca_status
    */
   MPCA_STATUS_BAD_SHAPE = 127,
   /**
-   * The output resolution or buffer length is wrong.
+   * The output resolution or buffer length is wrong (a length over
+   * PTRDIFF_MAX bytes included).
    */
   MPCA_STATUS_BAD_RESOLUTION = 128,
   /**
-   * A per-cell input has the wrong length.
+   * A length is wrong: a per-cell input not of the world's cell count, or
+   * more bytes than an object can have (over PTRDIFF_MAX).
    */
   MPCA_STATUS_BAD_LENGTH = 129,
   /**
@@ -397,9 +400,41 @@ typedef uint32_t mpca_cell_kind;
 #endif // __cplusplus
 
 /**
- * An opaque world. It lives in memory the caller handed to mpca_world_init
- * or that mpca_world_create allocated. (Not `repr(C)`, so cbindgen declares
- * it as an incomplete type.)
+ * An opaque world, reached through its handle: the `mpca_world *` that
+ * mpca_world_create or mpca_world_init wrote. A handle is only ever passed
+ * back to this library, never dereferenced. (Not `repr(C)`, so cbindgen
+ * declares it as an incomplete type.)
+ *
+ * Hosted builds (the default, with `std`): a handle is a value the library
+ * issues, not the world's address, and no value is issued twice in a
+ * process. The library keeps a registry of the live ones and asks it before
+ * it reads any memory, so every value that is not the handle of a live
+ * world is refused with `MPCA_STATUS_BAD_HANDLE` (NULL with
+ * `MPCA_STATUS_NULL_POINTER`) without a read: the handle of a destroyed or
+ * deinitialised world, even after its memory was freed or reused by the
+ * allocator or by a new world; the address of a world or of a copy of its
+ * bytes; any forged value. Building a world with mpca_world_init in memory
+ * that holds a live world ends that world: its handle is refused from then
+ * on. Where pointers are 32 bits wide the values run out after 2^32 - 1
+ * worlds in a process; create and init then return
+ * `MPCA_STATUS_OUT_OF_MEMORY`.
+ *
+ * Firmware builds (without `std`: no allocator, no registry): the handle
+ * is the world's address in the caller's memory, and the world's header
+ * holds a tag tied to that address, which mpca_world_deinit clears.
+ * Promised: NULL, and a value not aligned as a world's start, are refused
+ * without a read. Any other handle is read (the tag and the length after
+ * it: 16 bytes, 12 on 32-bit targets) and refused with
+ * `MPCA_STATUS_BAD_HANDLE` unless it holds the tag of a world built at
+ * exactly that address: so a deinitialised world whose memory is untouched
+ * since, a copy of a world's bytes at another address, and memory that
+ * never held a world are refused (bar a 2^-64 chance that such memory holds
+ * that very tag). Not promised: once the memory of a deinitialised world is
+ * freed or handed to anything else, passing its handle reads that memory,
+ * which is undefined behaviour if it is gone (as for any dangling pointer);
+ * and once mpca_world_init builds a new world at the same address, the old
+ * handle equals the new one and reaches the new world. End a world with
+ * mpca_world_deinit and drop its handle before the memory is reused.
  */
 typedef struct mpca_world mpca_world;
 
@@ -537,7 +572,8 @@ typedef struct mpca_emitter {
   float velocity[3];
   /**
    * Radius of a uniform random spread added to the velocity;
-   * |velocity| + spread <= 1.
+   * |velocity| + spread <= 1 (summed in double precision, so a sum above
+   * 1 by more than about 1e-16 is refused).
    */
   float spread;
   /**
@@ -745,7 +781,8 @@ mpca_status mpca_world_set_cell_potential(struct mpca_world *world, const uint32
 
 /**
  * Sets the Rankine vortex: centre (`cx`, `cy`), core radius and
- * circulation. Its axis is parallel to z in 3D.
+ * circulation. Its axis is parallel to z in 3D. The force is zero at the
+ * centre, however small the core.
  */
 mpca_status mpca_world_set_vortex(struct mpca_world *world,
                                   float cx,
@@ -765,6 +802,8 @@ mpca_status mpca_world_add_obstacle(struct mpca_world *world,
 /**
  * Every cell whose centre lies on the far side of the plane through `point`
  * with outward `normal` (3 values each): a floor when the normal points up.
+ * In 2D only the x and y of `normal` count, as for mpca_world_add_obstacle;
+ * a normal with neither is refused (`MPCA_STATUS_BAD_SHAPE`).
  */
 mpca_status mpca_world_add_half_space(struct mpca_world *world,
                                       const float *point,
@@ -820,15 +859,20 @@ mpca_status mpca_world_surface(const struct mpca_world *world,
 
 /**
  * Adds a particle of the world's mass at `pos` (3 values) with velocity
- * `velocity` (3 values; |v| <= 1; the third is ignored in 2D).
+ * `velocity` (3 values; the third is ignored in 2D), stored rounded to
+ * nearest. Accepted: components in [-1, 1] that round to a velocity the
+ * step itself can store, one within a quantum per axis (1/127 at 8 bits)
+ * of a velocity of length at most 1. That is every |v| <= 1 and every
+ * velocity mpca_world_cell and the exports report, so a world can be
+ * rebuilt from its own export; anything else is `MPCA_STATUS_SPEED_RANGE`.
  */
 mpca_status mpca_world_add_particle(struct mpca_world *world,
                                     const uint32_t *pos,
                                     const float *velocity);
 
 /**
- * Adds a particle of mass `mass`; worlds without per-particle masses accept
- * only their own mass.
+ * Adds a particle of mass `mass` (velocity as for mpca_world_add_particle);
+ * worlds without per-particle masses accept only their own mass.
  */
 mpca_status mpca_world_add_particle_mass(struct mpca_world *world,
                                          const uint32_t *pos,
@@ -909,9 +953,12 @@ const char *mpca_status_message(uint32_t status);
 
 /**
  * Builds an empty world in `memory` (`len` bytes, any alignment, at least
- * mpca_world_bytes) and writes its handle to `out_world`. Nothing is
+ * mpca_world_bytes; more than PTRDIFF_MAX is refused with
+ * `MPCA_STATUS_BAD_LENGTH`) and writes its handle to `out_world`. Nothing is
  * allocated. The world stays valid until mpca_world_deinit or until the
  * memory is freed or reused; do not move or copy the memory meanwhile.
+ * A world built over a live one ends it (see `mpca_world` for what its
+ * handle then does).
  */
 mpca_status mpca_world_init(const struct mpca_desc *desc,
                             void *memory,
@@ -919,8 +966,8 @@ mpca_status mpca_world_init(const struct mpca_desc *desc,
                             struct mpca_world **out_world);
 
 /**
- * Marks a world made by mpca_world_init as ended, so its handle is refused
- * from now on; the caller then frees or reuses the memory. A world made by
+ * Ends a world made by mpca_world_init, so its handle is refused from now
+ * on; the caller then frees or reuses the memory. A world made by
  * mpca_world_create is refused with `MPCA_STATUS_BAD_HANDLE`: destroy it.
  */
 mpca_status mpca_world_deinit(struct mpca_world *world);

@@ -9,16 +9,44 @@ use crate::query::Particle;
 use crate::world::World;
 use crate::Error;
 
+/// Whether stored components `q`, in quanta (`scale` to a cell per step),
+/// lie within one quantum per axis of a velocity of length at most 1. Those
+/// are the velocities the step stores: it clamps to `|v| <= 1` (M5.5), then
+/// rounds each component to one of the two integers around it (M1), which
+/// can leave `|q|` above `scale`. Also every `|v| <= 1` rounded to nearest,
+/// which moves a component by half a quantum at most. The point of the box
+/// `|x_k - q_k| <= 1` nearest the origin has `|x_k| = max(|q_k| - 1, 0)`; in
+/// integers, so the test is exact.
+fn storable(q: [i32; 3], scale: i32) -> bool {
+    let nearest: i64 = q
+        .iter()
+        .map(|&c| {
+            let x = i64::from(c.unsigned_abs().saturating_sub(1));
+            x * x
+        })
+        .sum();
+    nearest <= i64::from(scale) * i64::from(scale)
+}
+
 impl World {
-    /// Checks a velocity a caller hands in: finite, `|v| <= 1`, and zero on
-    /// the unused axis of 2D.
+    /// Checks a velocity a caller hands in: finite, zero on the unused axis
+    /// of 2D, each component in `[-1, 1]`, and, rounded to nearest as it will
+    /// be stored, a velocity the step itself can store (M1): see
+    /// [`storable`]. That takes every `|v| <= 1` and every velocity a world
+    /// reports, so a world can be rebuilt from what it reports.
     pub(crate) fn check_velocity(&self, v: [f32; 3]) -> Result<[f32; 3], Error> {
         crate::desc::finite(&v)?;
         let mut v = v;
         if self.dim() == 2 {
             v[2] = 0.0;
         }
-        if v[0] * v[0] + v[1] * v[1] + v[2] * v[2] > 1.0 {
+        if v.iter().any(|c| c.abs() > 1.0) {
+            return Err(Error::SpeedRange);
+        }
+        let ok = with_quant!(self.head.desc.quantization, Q => {
+            storable(v.map(|c| Q::nearest(c).to_int()), Q::SCALE as i32)
+        });
+        if !ok {
             return Err(Error::SpeedRange);
         }
         Ok(v)
@@ -108,5 +136,52 @@ impl World {
         put_bit(Cells::new(planes.occupancy), s.bit, false);
         head.counters.particles -= 1;
         Ok(p)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Description;
+
+    #[test]
+    fn storable_takes_what_the_step_stores_and_refuses_more() {
+        for scale in [127, 32767] {
+            // Every rounding of a velocity of length 1, in 2D and 3D.
+            for i in 0..1000 {
+                let a = i as f64 * 0.0062832;
+                let b = i as f64 * 0.0391;
+                let (ca, sa, cb, sb) = (libm::cos(a), libm::sin(a), libm::cos(b), libm::sin(b));
+                let dirs = [[ca, sa, 0.0], [ca * sb, sa * sb, cb]];
+                for u in dirs {
+                    let x = u.map(|c| c * f64::from(scale));
+                    for pick in 0..8 {
+                        let q: [i32; 3] =
+                            core::array::from_fn(|k| if pick >> k & 1 == 1 { libm::ceil(x[k]) as i32 } else { libm::floor(x[k]) as i32 });
+                        assert!(storable(q, scale), "{q:?} rounds {x:?}");
+                    }
+                }
+            }
+        }
+        assert!(storable([90, 90, 0], 127)); // (1, 1) / sqrt(2) rounded: |q| = 1.0022 * 127
+        assert!(!storable([102, 89, 0], 127)); // (0.8, 0.7)
+        assert!(!storable([76, 76, 76], 127)); // (0.6, 0.6, 0.6)
+        assert!(!storable([127, 127, 0], 127));
+    }
+
+    #[test]
+    fn a_velocity_read_back_is_accepted_again() {
+        let mut memory = [0u64; 512];
+        // SAFETY: the array's bytes, borrowed for this test only.
+        let bytes = unsafe { core::slice::from_raw_parts_mut(memory.as_mut_ptr().cast::<u8>(), 4096) };
+        let w = World::init(&Description::new_2d(8, 8), bytes).unwrap();
+        let h = core::f32::consts::FRAC_1_SQRT_2; // stored as 90/127, |v| = 1.0022
+        w.add_particle([1, 1, 0], [h, h, 0.0]).unwrap();
+        let p = w.remove_particle([1, 1, 0]).unwrap();
+        assert!(p.velocity[0] * p.velocity[0] + p.velocity[1] * p.velocity[1] > 1.0);
+        w.add_particle([1, 1, 0], p.velocity).unwrap();
+        assert_eq!(w.remove_particle([1, 1, 0]).unwrap(), p);
+        assert_eq!(w.add_particle([1, 1, 0], [1.0001, 0.0, 0.0]), Err(Error::SpeedRange));
+        assert_eq!(w.add_particle([1, 1, 0], [0.8, 0.7, 0.0]), Err(Error::SpeedRange));
     }
 }

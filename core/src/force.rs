@@ -73,13 +73,20 @@ impl ForceTerms<'_> {
 /// The static Rankine vortex force at point `p`: tangential, of magnitude
 /// `G/(2 pi) * r/R^2` inside the core and `G/(2 pi r)` outside, which is
 /// `G/(2 pi) * (-dy, dx) / max(r^2, R^2)`: no square root needed.
+///
+/// A component whose offset is zero is zero, whatever the factor: a core
+/// too small to square in `f32` (`R^2 = 0`) makes the factor infinite at the
+/// centre, or 0/0 without circulation, and `0 * inf` would be NaN, which the
+/// clamp (M5.5) counts as a stopped component. The force at the centre is
+/// zero for every core.
 #[inline]
 pub(crate) fn vortex_force(v: &Vortex, p: [f32; 2]) -> [f32; 2] {
     let dx = p[0] - v.centre[0];
     let dy = p[1] - v.centre[1];
     let r2 = (dx * dx + dy * dy).max(v.core_radius * v.core_radius);
     let s = v.circulation / (core::f32::consts::TAU * r2);
-    [-dy * s, dx * s]
+    let along = |d: f32| if d == 0.0 { 0.0 } else { d * s };
+    [-along(dy), along(dx)]
 }
 
 impl World {
@@ -177,5 +184,17 @@ mod tests {
         let f = vortex_force(&v, [0.0, 4.0]);
         assert!((f[0] + 0.25).abs() < 1e-6 && f[1].abs() < 1e-7);
         assert_eq!(vortex_force(&v, [0.0, 0.0]), [0.0, 0.0]);
+    }
+
+    #[test]
+    fn a_core_too_small_to_square_gives_no_force_at_the_centre() {
+        for circulation in [0.0, 1.0, -3e38] {
+            let v = Vortex { centre: [4.5, 4.5], core_radius: 1e-30, circulation };
+            let f = vortex_force(&v, [4.5, 4.5]);
+            assert!(f[0] == 0.0 && f[1] == 0.0, "{circulation}: {f:?}");
+            // On an axis through the centre: no component across it.
+            let f = vortex_force(&v, [4.5, 5.5]);
+            assert!(f[1] == 0.0 && !f[0].is_nan(), "{circulation}: {f:?}");
+        }
     }
 }

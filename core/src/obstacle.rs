@@ -46,7 +46,9 @@ pub enum Shape {
     HalfSpace {
         /// A point on the plane.
         point: [f32; 3],
-        /// Outward normal; need not be unit length, must not be zero.
+        /// Outward normal; need not be unit length, must not be zero. In 2D
+        /// only its x and y count (as for [`World::add_obstacle`]'s normal),
+        /// and they must not both be zero.
         normal: [f32; 3],
     },
     /// An axis-aligned box `min <= centre <= max`.
@@ -100,12 +102,23 @@ type Mask<'a> = &'a dyn Fn([usize; 3]) -> bool;
 type NormalFn<'a> = &'a dyn Fn(&World, [usize; 3], Mask<'_>) -> [f32; 3];
 
 impl Shape {
+    /// The shape as a world of `dim` dimensions uses it: in 2D a
+    /// half-space's normal loses its z, as [`World::add_obstacle`]'s does
+    /// (every other shape reads only the axes the world has).
+    fn in_dim(self, dim: usize) -> Shape {
+        match self {
+            Shape::HalfSpace { point, normal } => Shape::HalfSpace { point, normal: in_plane(normal, dim) },
+            other => other,
+        }
+    }
+
+    /// Checks every float as given, then the shape as the world uses it.
     fn check(&self, dim: usize) -> Result<(), Error> {
         match *self {
             Shape::HalfSpace { point, normal } => {
                 finite(&point)?;
                 finite(&normal)?;
-                normalise(normal).ok_or(Error::BadShape)?;
+                normalise(in_plane(normal, dim)).ok_or(Error::BadShape)?;
             }
             Shape::Box { min, max } => {
                 finite(&min)?;
@@ -207,6 +220,11 @@ impl Shape {
         }
         (a, b)
     }
+}
+
+/// A normal without the z a 2D world does not have.
+fn in_plane(normal: [f32; 3], dim: usize) -> [f32; 3] {
+    if dim == 2 { [normal[0], normal[1], 0.0] } else { normal }
 }
 
 fn centre(c: [usize; 3]) -> [f32; 3] {
@@ -420,10 +438,7 @@ impl World {
     pub fn add_obstacle(&mut self, pos: [u32; 3], normal: [f32; 3], e: f32) -> Result<(), Error> {
         self.locate(pos)?;
         finite(&normal)?;
-        let mut nrm = normal;
-        if self.dim() == 2 {
-            nrm[2] = 0.0;
-        }
+        let nrm = in_plane(normal, self.dim());
         normalise(nrm).ok_or(Error::UndefinedNormal)?;
         let c = pos.map(|v| v as usize);
         self.add_obstacles(c, c.map(|v| v + 1), e, &|q| q == c, &|_, _, _| nrm, false)
@@ -434,6 +449,7 @@ impl World {
     pub fn add_shape(&mut self, shape: Shape, e: f32) -> Result<(), Error> {
         let dim = self.dim();
         shape.check(dim)?;
+        let shape = shape.in_dim(dim);
         let (lo, hi) = shape.bounds(self.layout().n, dim);
         let normal = |_: &World, c, _: Mask<'_>| shape.normal(centre(c), dim);
         self.add_obstacles(lo, hi, e, &|c| shape.contains(centre(c), dim), &normal, false)

@@ -22,7 +22,7 @@ pub unsafe extern "C" fn mpca_world_set_gravity(world: *mut mpca_world, g: *cons
 pub unsafe extern "C" fn mpca_world_set_force_field(world: *mut mpca_world, forces: *const f32, len: usize) -> mpca_status {
     guard(|| {
         let w = unsafe { world_mut(world)? };
-        Ok(w.set_force_field(unsafe { slice(forces, len)? })?)
+        Ok(w.set_force_field(unsafe { slice(forces, len, mpca_status::BadLength)? })?)
     })
 }
 
@@ -41,7 +41,7 @@ pub unsafe extern "C" fn mpca_world_set_cell_force(world: *mut mpca_world, pos: 
 pub unsafe extern "C" fn mpca_world_set_potential(world: *mut mpca_world, u: *const f32, len: usize) -> mpca_status {
     guard(|| {
         let w = unsafe { world_mut(world)? };
-        Ok(w.set_potential(unsafe { slice(u, len)? })?)
+        Ok(w.set_potential(unsafe { slice(u, len, mpca_status::BadLength)? })?)
     })
 }
 
@@ -55,7 +55,8 @@ pub unsafe extern "C" fn mpca_world_set_cell_potential(world: *mut mpca_world, p
 }
 
 /// Sets the Rankine vortex: centre (`cx`, `cy`), core radius and
-/// circulation. Its axis is parallel to z in 3D.
+/// circulation. Its axis is parallel to z in 3D. The force is zero at the
+/// centre, however small the core.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_world_set_vortex(world: *mut mpca_world, cx: f32, cy: f32, core_radius: f32, circulation: f32) -> mpca_status {
     guard(|| {

@@ -5,11 +5,12 @@
 //!
 //! - **NULL** for any pointer argument returns `MPCA_STATUS_NULL_POINTER`;
 //!   nothing is dereferenced first.
-//! - **Handles** carry a tag tied to their address, cleared by
-//!   `mpca_world_destroy` / `mpca_world_deinit`; a destroyed, deinitialised
-//!   or forged handle returns `MPCA_STATUS_BAD_HANDLE`. Worlds from
-//!   `mpca_world_create` are also kept in a registry, so a destroyed one is
-//!   refused without its freed memory being read.
+//! - **Handles** (`handle.rs`): in hosted builds a value the library issues
+//!   once and looks up in a registry of live worlds before reading any
+//!   memory, so a destroyed, deinitialised or forged handle returns
+//!   `MPCA_STATUS_BAD_HANDLE` whatever became of the memory. Firmware
+//!   builds have no registry: the handle is the world's address, checked by
+//!   a tag tied to it, with the limits `mpca_world` documents.
 //! - **Bad values** (NaN, infinities, out-of-range numbers, unknown enum
 //!   values, wrong `struct_size`) return a status and leave the world
 //!   unchanged.
@@ -30,6 +31,7 @@ extern crate std;
 mod desc;
 mod emitters;
 mod forces;
+mod handle;
 mod obstacles;
 mod particles;
 mod status;
@@ -112,23 +114,39 @@ pub(crate) unsafe fn array<T: Copy, const N: usize>(p: *const T) -> Result<[T; N
     Ok(core::array::from_fn(|i| unsafe { p.add(i).read() }))
 }
 
-/// A slice of `len` values at `p`; NULL is refused even when `len` is 0.
+/// Whether `len` values of `T` fit in one object: at most `isize::MAX`
+/// bytes, the bound `core::slice::from_raw_parts` requires.
 #[inline]
-pub(crate) unsafe fn slice<'a, T>(p: *const T, len: usize) -> Result<&'a [T], mpca_status> {
+fn fits<T>(len: usize) -> bool {
+    len <= isize::MAX as usize / core::mem::size_of::<T>().max(1)
+}
+
+/// A slice of `len` values at `p`; NULL is refused even when `len` is 0, and
+/// a length no object can have with `too_long`, before any slice is formed.
+#[inline]
+pub(crate) unsafe fn slice<'a, T>(p: *const T, len: usize, too_long: mpca_status) -> Result<&'a [T], mpca_status> {
     if p.is_null() {
         return Err(mpca_status::NullPointer);
     }
-    // SAFETY: the C contract: `p` points at `len` readable values.
+    if !fits::<T>(len) {
+        return Err(too_long);
+    }
+    // SAFETY: not NULL, and `len` values span at most isize::MAX bytes;
+    // the C contract: `p` points at `len` readable values.
     Ok(unsafe { core::slice::from_raw_parts(p, len) })
 }
 
-/// A mutable slice of `len` values at `p`; NULL is refused.
+/// A mutable slice of `len` values at `p`; NULL and lengths no object can
+/// have are refused, as in [`slice`].
 #[inline]
-pub(crate) unsafe fn slice_mut<'a, T>(p: *mut T, len: usize) -> Result<&'a mut [T], mpca_status> {
+pub(crate) unsafe fn slice_mut<'a, T>(p: *mut T, len: usize, too_long: mpca_status) -> Result<&'a mut [T], mpca_status> {
     if p.is_null() {
         return Err(mpca_status::NullPointer);
     }
-    // SAFETY: the C contract: `p` points at `len` writable values.
+    if !fits::<T>(len) {
+        return Err(too_long);
+    }
+    // SAFETY: as in `slice`, for `len` writable values.
     Ok(unsafe { core::slice::from_raw_parts_mut(p, len) })
 }
 

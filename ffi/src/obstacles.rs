@@ -19,6 +19,8 @@ pub unsafe extern "C" fn mpca_world_add_obstacle(world: *mut mpca_world, pos: *c
 
 /// Every cell whose centre lies on the far side of the plane through `point`
 /// with outward `normal` (3 values each): a floor when the normal points up.
+/// In 2D only the x and y of `normal` count, as for mpca_world_add_obstacle;
+/// a normal with neither is refused (`MPCA_STATUS_BAD_SHAPE`).
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_world_add_half_space(world: *mut mpca_world, point: *const f32, normal: *const f32, e: f32) -> mpca_status {
     guard(|| {
@@ -66,7 +68,7 @@ pub unsafe extern "C" fn mpca_world_add_sphere(world: *mut mpca_world, centre: *
 pub unsafe extern "C" fn mpca_world_add_obstacle_mask(world: *mut mpca_world, mask: *const u8, len: usize, e: f32) -> mpca_status {
     guard(|| {
         let w = unsafe { world_mut(world)? };
-        let mask = unsafe { slice(mask, len)? };
+        let mask = unsafe { slice(mask, len, mpca_status::BadLength)? };
         Ok(w.add_obstacle_mask(mask, e)?)
     })
 }

@@ -47,7 +47,12 @@ fn particle_to_c(p: Particle) -> mpca_particle {
 }
 
 /// Adds a particle of the world's mass at `pos` (3 values) with velocity
-/// `velocity` (3 values; |v| <= 1; the third is ignored in 2D).
+/// `velocity` (3 values; the third is ignored in 2D), stored rounded to
+/// nearest. Accepted: components in [-1, 1] that round to a velocity the
+/// step itself can store, one within a quantum per axis (1/127 at 8 bits)
+/// of a velocity of length at most 1. That is every |v| <= 1 and every
+/// velocity mpca_world_cell and the exports report, so a world can be
+/// rebuilt from its own export; anything else is `MPCA_STATUS_SPEED_RANGE`.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_world_add_particle(world: *mut mpca_world, pos: *const u32, velocity: *const f32) -> mpca_status {
     guard(|| {
@@ -57,8 +62,8 @@ pub unsafe extern "C" fn mpca_world_add_particle(world: *mut mpca_world, pos: *c
     })
 }
 
-/// Adds a particle of mass `mass`; worlds without per-particle masses accept
-/// only their own mass.
+/// Adds a particle of mass `mass` (velocity as for mpca_world_add_particle);
+/// worlds without per-particle masses accept only their own mass.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_world_add_particle_mass(
     world: *mut mpca_world,
@@ -134,7 +139,8 @@ unsafe fn export(
         if capacity < n {
             return Err(mpca_status::OutputTooSmall);
         }
-        let dst = unsafe { slice_mut(out, n * per)? };
+        let floats = n.checked_mul(per).ok_or(mpca_status::OutputTooSmall)?;
+        let dst = unsafe { slice_mut(out, floats, mpca_status::OutputTooSmall)? };
         for (p, chunk) in w.particles().zip(dst.chunks_exact_mut(per)) {
             put(&p, chunk);
         }
@@ -187,7 +193,7 @@ pub unsafe extern "C" fn mpca_world_density(world: *const mpca_world, res: *cons
     guard(|| {
         let w = unsafe { world_ref(world)? };
         let res = unsafe { array(res)? };
-        let out = unsafe { slice_mut(out, len)? };
+        let out = unsafe { slice_mut(out, len, mpca_status::BadResolution)? };
         Ok(w.density(res, out)?)
     })
 }
@@ -198,7 +204,7 @@ pub unsafe extern "C" fn mpca_world_density_u8(world: *const mpca_world, res: *c
     guard(|| {
         let w = unsafe { world_ref(world)? };
         let res = unsafe { array(res)? };
-        let out = unsafe { slice_mut(out, len)? };
+        let out = unsafe { slice_mut(out, len, mpca_status::BadResolution)? };
         Ok(w.density_u8(res, out)?)
     })
 }

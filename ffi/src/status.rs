@@ -84,9 +84,11 @@ pub enum mpca_status {
     LifetimeRange = 126,
     /// A shape is degenerate.
     BadShape = 127,
-    /// The output resolution or buffer length is wrong.
+    /// The output resolution or buffer length is wrong (a length over
+    /// PTRDIFF_MAX bytes included).
     BadResolution = 128,
-    /// A per-cell input has the wrong length.
+    /// A length is wrong: a per-cell input not of the world's cell count, or
+    /// more bytes than an object can have (over PTRDIFF_MAX).
     BadLength = 129,
     /// The world lives in caller memory: use mpca_world_deinit, and free the
     /// memory yourself.
@@ -181,7 +183,7 @@ impl mpca_status {
             S::LifetimeRange => c"a lifetime is longer than 65535 steps",
             S::BadShape => c"a shape is degenerate",
             S::BadResolution => c"the output resolution or buffer length is wrong",
-            S::BadLength => c"a per-cell input has the wrong length",
+            S::BadLength => c"a per-cell input has the wrong length, or a length exceeds PTRDIFF_MAX bytes",
             S::NotOwned => c"the world lives in caller memory: deinit it and free the memory yourself",
             S::OutOfMemory => c"the allocator refused the memory",
             S::Unknown => c"an error this version of the C ABI does not name",

@@ -2,60 +2,45 @@
 
 use mpca_core::World;
 
-use crate::{check_size, guard, mpca_desc, mpca_status, read, write};
+use crate::{check_size, guard, handle, mpca_desc, mpca_status, read, write};
 
-/// An opaque world. It lives in memory the caller handed to mpca_world_init
-/// or that mpca_world_create allocated. (Not `repr(C)`, so cbindgen declares
-/// it as an incomplete type.)
+/// An opaque world, reached through its handle: the `mpca_world *` that
+/// mpca_world_create or mpca_world_init wrote. A handle is only ever passed
+/// back to this library, never dereferenced. (Not `repr(C)`, so cbindgen
+/// declares it as an incomplete type.)
+///
+/// Hosted builds (the default, with `std`): a handle is a value the library
+/// issues, not the world's address, and no value is issued twice in a
+/// process. The library keeps a registry of the live ones and asks it before
+/// it reads any memory, so every value that is not the handle of a live
+/// world is refused with `MPCA_STATUS_BAD_HANDLE` (NULL with
+/// `MPCA_STATUS_NULL_POINTER`) without a read: the handle of a destroyed or
+/// deinitialised world, even after its memory was freed or reused by the
+/// allocator or by a new world; the address of a world or of a copy of its
+/// bytes; any forged value. Building a world with mpca_world_init in memory
+/// that holds a live world ends that world: its handle is refused from then
+/// on. Where pointers are 32 bits wide the values run out after 2^32 - 1
+/// worlds in a process; create and init then return
+/// `MPCA_STATUS_OUT_OF_MEMORY`.
+///
+/// Firmware builds (without `std`: no allocator, no registry): the handle
+/// is the world's address in the caller's memory, and the world's header
+/// holds a tag tied to that address, which mpca_world_deinit clears.
+/// Promised: NULL, and a value not aligned as a world's start, are refused
+/// without a read. Any other handle is read (the tag and the length after
+/// it: 16 bytes, 12 on 32-bit targets) and refused with
+/// `MPCA_STATUS_BAD_HANDLE` unless it holds the tag of a world built at
+/// exactly that address: so a deinitialised world whose memory is untouched
+/// since, a copy of a world's bytes at another address, and memory that
+/// never held a world are refused (bar a 2^-64 chance that such memory holds
+/// that very tag). Not promised: once the memory of a deinitialised world is
+/// freed or handed to anything else, passing its handle reads that memory,
+/// which is undefined behaviour if it is gone (as for any dangling pointer);
+/// and once mpca_world_init builds a new world at the same address, the old
+/// handle equals the new one and reaches the new world. End a world with
+/// mpca_world_deinit and drop its handle before the memory is reused.
 pub struct mpca_world {
     _opaque: [u8; 0],
-}
-
-/// Registry of the worlds mpca_world_create made and mpca_world_destroy
-/// freed, so that a destroyed handle is refused without reading freed memory.
-#[cfg(feature = "std")]
-mod registry {
-    use std::collections::BTreeSet;
-    use std::sync::Mutex;
-
-    struct Sets {
-        live: BTreeSet<usize>,
-        dead: BTreeSet<usize>,
-    }
-
-    static SETS: Mutex<Sets> = Mutex::new(Sets { live: BTreeSet::new(), dead: BTreeSet::new() });
-
-    fn with<R>(f: impl FnOnce(&mut Sets) -> R) -> R {
-        let mut g = SETS.lock().unwrap_or_else(|e| e.into_inner());
-        f(&mut g)
-    }
-
-    pub fn born(p: usize) {
-        with(|s| {
-            s.dead.remove(&p);
-            s.live.insert(p);
-        });
-    }
-
-    /// A world built by mpca_world_init at `p`, perhaps where a destroyed
-    /// one was: the address is live memory again.
-    pub fn reused(p: usize) {
-        with(|s| {
-            s.dead.remove(&p);
-        });
-    }
-
-    pub fn died(p: usize) {
-        with(|s| {
-            s.live.remove(&p);
-            s.dead.insert(p);
-        });
-    }
-
-    /// False for the address of a destroyed world not since reused.
-    pub fn may_read(p: usize) -> bool {
-        with(|s| s.live.contains(&p) || !s.dead.contains(&p))
-    }
 }
 
 /// The world behind a handle: NULL and dead handles are refused.
@@ -63,13 +48,14 @@ pub(crate) unsafe fn world_mut<'a>(w: *mut mpca_world) -> Result<&'a mut World, 
     if w.is_null() {
         return Err(mpca_status::NullPointer);
     }
-    #[cfg(feature = "std")]
-    if !registry::may_read(w as usize) {
-        return Err(mpca_status::BadHandle);
-    }
-    // SAFETY: the C contract: a handle is a pointer this library returned.
-    // Its tag is checked before anything else is read.
-    unsafe { World::from_ptr(w.cast::<u8>()) }.map_err(|_| mpca_status::BadHandle)
+    let at = handle::resolve(w)?;
+    // SAFETY: hosted builds: `at` is where a world was built and registered,
+    // and its handle was not revoked since, so the memory is that world's
+    // (the C contract: memory handed to mpca_world_init stays until deinit).
+    // Firmware builds: the C contract that a handle is an address this
+    // library returned, still readable. Either way the tag is checked before
+    // anything else is read.
+    unsafe { World::from_ptr(at) }.map_err(|_| mpca_status::BadHandle)
 }
 
 /// Read-only twin of [`world_mut`].
@@ -78,9 +64,12 @@ pub(crate) unsafe fn world_ref<'a>(w: *const mpca_world) -> Result<&'a World, mp
 }
 
 /// Builds an empty world in `memory` (`len` bytes, any alignment, at least
-/// mpca_world_bytes) and writes its handle to `out_world`. Nothing is
+/// mpca_world_bytes; more than PTRDIFF_MAX is refused with
+/// `MPCA_STATUS_BAD_LENGTH`) and writes its handle to `out_world`. Nothing is
 /// allocated. The world stays valid until mpca_world_deinit or until the
 /// memory is freed or reused; do not move or copy the memory meanwhile.
+/// A world built over a live one ends it (see `mpca_world` for what its
+/// handle then does).
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_world_init(
     desc: *const mpca_desc,
@@ -91,18 +80,16 @@ pub unsafe extern "C" fn mpca_world_init(
     guard(|| {
         let d = unsafe { read(desc)? }.to_core()?;
         let out = unsafe { write(out_world)? };
-        let bytes = unsafe { crate::slice_mut(memory.cast::<u8>(), len)? };
+        let bytes = unsafe { crate::slice_mut(memory.cast::<u8>(), len, mpca_status::BadLength)? };
+        let number = handle::reserve()?;
         let world = World::init(&d, bytes)?;
-        let p = world.as_ptr();
-        #[cfg(feature = "std")]
-        registry::reused(p as usize);
-        *out = p.cast::<mpca_world>();
+        *out = handle::issue(number, world);
         Ok(())
     })
 }
 
-/// Marks a world made by mpca_world_init as ended, so its handle is refused
-/// from now on; the caller then frees or reuses the memory. A world made by
+/// Ends a world made by mpca_world_init, so its handle is refused from now
+/// on; the caller then frees or reuses the memory. A world made by
 /// mpca_world_create is refused with `MPCA_STATUS_BAD_HANDLE`: destroy it.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_world_deinit(world: *mut mpca_world) -> mpca_status {
@@ -112,6 +99,7 @@ pub unsafe extern "C" fn mpca_world_deinit(world: *mut mpca_world) -> mpca_statu
             return Err(mpca_status::BadHandle);
         }
         w.retire();
+        handle::revoke(world);
         Ok(())
     })
 }
@@ -125,9 +113,11 @@ pub unsafe extern "C" fn mpca_world_create(desc: *const mpca_desc, out_world: *m
     guard(|| {
         let d = unsafe { read(desc)? }.to_core()?;
         let out = unsafe { write(out_world)? };
-        let p = mpca_core::WorldBox::new(&d)?.into_raw();
-        registry::born(p as usize);
-        *out = p.cast::<mpca_world>();
+        let number = handle::reserve()?;
+        let mut world = mpca_core::WorldBox::new(&d)?;
+        *out = handle::issue(number, &mut world);
+        // Owned through the handle from now on; mpca_world_destroy frees it.
+        let _ = world.into_raw();
         Ok(())
     })
 }
@@ -142,11 +132,12 @@ pub unsafe extern "C" fn mpca_world_destroy(world: *mut mpca_world) -> mpca_stat
         if world.is_null() {
             return Ok(());
         }
-        unsafe { world_mut(world)? };
-        // SAFETY: a live world handle (checked above).
-        let b = unsafe { mpca_core::WorldBox::from_raw(world.cast::<u8>())? };
-        registry::died(world as usize);
-        drop(b);
+        let at = handle::resolve(world)?;
+        // SAFETY: the registry holds `at` for a live handle (see world_mut);
+        // from_raw checks the tag, and that the library allocated it.
+        let owned = unsafe { mpca_core::WorldBox::from_raw(at)? };
+        handle::revoke(world);
+        drop(owned);
         Ok(())
     })
 }

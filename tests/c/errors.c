@@ -493,6 +493,14 @@ static void memory_cases(void) {
     }
     /* Some offset in 64 needs the full slack. */
     CHECK(refused_short > 0);
+
+    /* Lengths no buffer can have (more than PTRDIFF_MAX bytes). */
+    set_context("mpca_world_init with a length beyond PTRDIFF_MAX");
+    mpca_world *w = NULL;
+    memset(pool, SENTINEL_BYTE, POOL_BYTES);
+    REFUSED(MPCA_STATUS_BAD_LENGTH, mpca_world_init(&d, pool, SIZE_MAX, &w));
+    REFUSED(MPCA_STATUS_BAD_LENGTH, mpca_world_init(&d, pool, (size_t)PTRDIFF_MAX + 1, &w));
+    CHECK(w == NULL && pool[0] == SENTINEL_BYTE && pool[POOL_BYTES - 1] == SENTINEL_BYTE);
 }
 
 /* --- Handles ----------------------------------------------------------- */
@@ -566,16 +574,26 @@ static void handle_cases(void) {
     memset(forged, SENTINEL_BYTE, 8192);
     handle_sweep((mpca_world *)(void *)forged, MPCA_STATUS_BAD_HANDLE, "forged, garbage memory");
 
-    /* A byte-for-byte copy of a live world elsewhere: the tag is tied to
-     * the address, so the copy is not a world. */
-    size_t offset = (size_t)((unsigned char *)full2 - full2_memory);
-    unsigned char *copy_raw = malloc(full2_bytes + 5 + 128);
+    /* A byte-for-byte copy of a live world elsewhere is not a world, and
+     * neither is the live world's own memory: a handle is what
+     * mpca_world_init returned, not an address. Every 8-byte aligned
+     * address where a world could start in either (it starts within the
+     * first 5 + 64 bytes: 5 of misalignment, then the alignment slack). */
+    unsigned char *copy_raw = malloc(full2_bytes + 5 + 64);
     CHECK(copy_raw != NULL);
-    unsigned char *copy_handle = align64(copy_raw + offset) + 64;
-    memcpy(copy_handle - offset, full2_memory, full2_bytes + 5);
-    handle_sweep((mpca_world *)(void *)copy_handle, MPCA_STATUS_BAD_HANDLE, "a copy of a live world");
+    unsigned char *copy = align64(copy_raw);
+    memcpy(copy, full2_memory, full2_bytes + 5);
+    for (size_t offset = 0; offset < 5 + 64; offset++) {
+        if ((uintptr_t)(copy + offset) % 8 == 0) {
+            handle_sweep((mpca_world *)(void *)(copy + offset), MPCA_STATUS_BAD_HANDLE, "a copy of a live world");
+        }
+        if ((uintptr_t)(full2_memory + offset) % 8 == 0) {
+            handle_sweep((mpca_world *)(void *)(full2_memory + offset), MPCA_STATUS_BAD_HANDLE,
+                         "the memory of a live world");
+        }
+    }
 
-    /* Pointers into a live world: misaligned, and aligned but not its start. */
+    /* Near a live handle: misaligned, and aligned but not the handle. */
     handle_sweep((mpca_world *)(void *)((unsigned char *)full2 + 8), MPCA_STATUS_BAD_HANDLE, "live world + 8");
     handle_sweep((mpca_world *)(void *)((unsigned char *)full2 + 64), MPCA_STATUS_BAD_HANDLE, "live world + 64");
 
@@ -590,6 +608,21 @@ static void handle_cases(void) {
     CHECK_OK(mpca_world_init(&d, memory, bytes, &w));
     CHECK_OK(mpca_world_deinit(w));
     handle_sweep(w, MPCA_STATUS_BAD_HANDLE, "deinitialised");
+
+    /* Deinitialised, its memory then freed: refused without a read of the
+     * freed memory. 512 x 512 cells, so that free gives the block back to
+     * the system and a read of it faults (ASan reports any size). */
+    mpca_desc big;
+    size_t big_bytes = 0;
+    CHECK_OK(mpca_desc_defaults(&big, 2, 512, 512, 0));
+    CHECK_OK(mpca_world_bytes(&big, &big_bytes));
+    unsigned char *big_memory = malloc(big_bytes);
+    CHECK(big_memory != NULL);
+    mpca_world *gone = NULL;
+    CHECK_OK(mpca_world_init(&big, big_memory, big_bytes, &gone));
+    CHECK_OK(mpca_world_deinit(gone));
+    free(big_memory);
+    handle_sweep(gone, MPCA_STATUS_BAD_HANDLE, "deinitialised, memory freed");
 
     /* Destroyed, and destroyed twice (the sweep ends with a second
      * mpca_world_destroy). No world is created between the destroy and the
@@ -730,6 +763,14 @@ static void emitter_cases(void) {
         x.velocity[1] = x.velocity[2] = 0;
         x.spread = 0.6f; /* |v| + spread > 1 */
         REFUSED(MPCA_STATUS_SPEED_RANGE, mpca_world_add_emitter(w, &x, &index));
+        /* |v| + spread above 1 by less than a float's spacing at 1: a sum
+         * in float rounds both to 1. */
+        x.spread = nextafterf(0.5f, 1.0f);
+        REFUSED(MPCA_STATUS_SPEED_RANGE, mpca_world_add_emitter(w, &x, &index));
+        x.velocity[0] = 0;
+        x.velocity[1] = 0.75f;
+        x.spread = nextafterf(0.25f, 1.0f);
+        REFUSED(MPCA_STATUS_SPEED_RANGE, mpca_world_add_emitter(w, &x, &index));
         x = e;
         x.lifetime = 65536;
         REFUSED(MPCA_STATUS_LIFETIME_RANGE, mpca_world_add_emitter(w, &x, &index));
@@ -828,6 +869,11 @@ static void force_cases(void) {
         REFUSED(MPCA_STATUS_BAD_LENGTH, mpca_world_set_force_field(w, field, 0));
         REFUSED(MPCA_STATUS_BAD_LENGTH, mpca_world_set_potential(w, potential, cells - 1));
         REFUSED(MPCA_STATUS_BAD_LENGTH, mpca_world_set_potential(w, potential, 0));
+        /* Lengths no array can have (more than PTRDIFF_MAX bytes). */
+        REFUSED(MPCA_STATUS_BAD_LENGTH, mpca_world_set_force_field(w, field, SIZE_MAX));
+        REFUSED(MPCA_STATUS_BAD_LENGTH, mpca_world_set_force_field(w, field, (size_t)PTRDIFF_MAX / sizeof(float) + 1));
+        REFUSED(MPCA_STATUS_BAD_LENGTH, mpca_world_set_potential(w, potential, SIZE_MAX));
+        REFUSED(MPCA_STATUS_BAD_LENGTH, mpca_world_set_potential(w, potential, (size_t)PTRDIFF_MAX / sizeof(float) + 1));
         EACH_OUTSIDE(pos, dim, n, mpca_world_set_cell_force(w, pos, f));
         EACH_OUTSIDE(pos, dim, n, mpca_world_set_cell_potential(w, pos, u));
     }
@@ -893,6 +939,7 @@ static void obstacle_cases(void) {
     float zero[3] = {0, 0, 0}, z_only[3] = {0, 0, 1};
     REFUSED(MPCA_STATUS_UNDEFINED_NORMAL, mpca_world_add_obstacle(full2, cell2, zero, e));
     REFUSED(MPCA_STATUS_UNDEFINED_NORMAL, mpca_world_add_obstacle(full2, cell2, z_only, e)); /* no z in 2D */
+    REFUSED(MPCA_STATUS_BAD_SHAPE, mpca_world_add_half_space(full2, point, z_only, e));       /* nor here */
     REFUSED(MPCA_STATUS_UNDEFINED_NORMAL, mpca_world_add_obstacle(full3, cell3, zero, e));
     REFUSED(MPCA_STATUS_BAD_SHAPE, mpca_world_add_half_space(full2, point, zero, e));
     REFUSED(MPCA_STATUS_BAD_SHAPE, mpca_world_add_half_space(full3, point, zero, e));
@@ -908,6 +955,8 @@ static void obstacle_cases(void) {
     REFUSED(MPCA_STATUS_BAD_LENGTH, mpca_world_add_obstacle_mask(full2, mask2, CELLS2 - 1, e));
     REFUSED(MPCA_STATUS_BAD_LENGTH, mpca_world_add_obstacle_mask(full2, mask2, CELLS2 + 1, e));
     REFUSED(MPCA_STATUS_BAD_LENGTH, mpca_world_add_obstacle_mask(full3, mask3, CELLS3 - 1, e));
+    REFUSED(MPCA_STATUS_BAD_LENGTH, mpca_world_add_obstacle_mask(full2, mask2, SIZE_MAX, e));
+    REFUSED(MPCA_STATUS_BAD_LENGTH, mpca_world_add_obstacle_mask(full2, mask2, (size_t)PTRDIFF_MAX + 1, e));
     /* A wall one cell thick across the world: free on both sides, so the
      * normal of its inner cells vanishes (M7). */
     unsigned char wall[CELLS2] = {0};
@@ -1063,6 +1112,11 @@ static void output_cases(void) {
         REFUSED(MPCA_STATUS_BAD_RESOLUTION, mpca_world_density(full2, res, out, lens[at]));
         REFUSED(MPCA_STATUS_BAD_RESOLUTION, mpca_world_density_u8(full2, res, bytes, lens[at]));
     }
+    set_context("density buffers longer than PTRDIFF_MAX bytes");
+    REFUSED(MPCA_STATUS_BAD_RESOLUTION, mpca_world_density(full2, res, out, SIZE_MAX));
+    REFUSED(MPCA_STATUS_BAD_RESOLUTION, mpca_world_density(full2, res, out, (size_t)PTRDIFF_MAX / sizeof(float) + 1));
+    REFUSED(MPCA_STATUS_BAD_RESOLUTION, mpca_world_density_u8(full2, res, bytes, SIZE_MAX));
+    REFUSED(MPCA_STATUS_BAD_RESOLUTION, mpca_world_density_u8(full2, res, bytes, (size_t)PTRDIFF_MAX + 1));
 
     set_context("statistics struct_size");
     const uint32_t sizes[4] = {0, sizeof(mpca_stats) - 8, sizeof(mpca_stats) + 8, UINT32_MAX};

@@ -7,7 +7,11 @@
 //! - `scenes.c` (linked dynamically): a 2D and a 3D scene stepped from C,
 //!   whose hashes and statistics must equal those of the same scenes built
 //!   here through the Rust API; the exports against the cells.
-//! - `reuse.c`: caller memory at the address of a destroyed world.
+//! - `reuse.c`: handles after their worlds end, while the allocator and
+//!   the caller reuse the memory those worlds lived in.
+//! - `edges.c` (linked statically): inputs at the edges of the model, judged
+//!   by what the world then does: 2D half-space normals, a vortex with a
+//!   tiny core, a world rebuilt from its own export.
 //! - `header_only.c`: `include/mpca.h` alone, as C99 and as C++11.
 //!
 //! With `MPCA_C_SANITIZE=1` every program is built with AddressSanitizer
@@ -209,8 +213,9 @@ fn run(exe: PathBuf, asan_options: &str) -> Run {
     run
 }
 
-/// The runs of `errors.c` (static), `scenes.c` (shared) and `reuse.c`
-/// (shared), each built and run once per test process.
+/// The runs of `errors.c` (static), `scenes.c` (shared), `reuse.c`
+/// (shared) and `edges.c` (static), each built and run once per test
+/// process.
 fn errors() -> &'static Run {
     static RUN: OnceLock<Run> = OnceLock::new();
     RUN.get_or_init(|| run(build("errors", &["errors.c", "check.c"], Link::Static), ""))
@@ -223,10 +228,20 @@ fn scenes() -> &'static Run {
 
 fn reuse() -> &'static Run {
     static RUN: OnceLock<Run> = OnceLock::new();
-    // Without its quarantine ASan hands freed blocks back, as glibc does.
+    // Without its quarantine ASan hands freed blocks back, as glibc does;
+    // without its fill of new blocks they keep what they held, by which
+    // reuse.c knows the block of a destroyed world.
     RUN.get_or_init(|| {
-        run(build("reuse", &["reuse.c", "check.c"], Link::Shared), ":quarantine_size_mb=0:thread_local_quarantine_size_kb=0")
+        run(
+            build("reuse", &["reuse.c", "check.c"], Link::Shared),
+            ":quarantine_size_mb=0:thread_local_quarantine_size_kb=0:max_malloc_fill_size=0",
+        )
     })
+}
+
+fn edges() -> &'static Run {
+    static RUN: OnceLock<Run> = OnceLock::new();
+    RUN.get_or_init(|| run(build("edges", &["edges.c", "check.c"], Link::Static), ""))
 }
 
 /// `include/mpca.h` without its comments.
@@ -632,7 +647,7 @@ fn exports_from_c_agree_with_the_cells_and_the_density() {
 
 #[test]
 fn sanitizers_are_linked_in_exactly_when_asked() {
-    for run in [errors(), scenes(), reuse()] {
+    for run in [errors(), scenes(), reuse(), edges()] {
         let printed = run.value("sanitizer: ");
         let needed = Elf::read(&run.exe).needed();
         let asan = needed.iter().any(|n| n.starts_with("libasan.so"));
@@ -656,6 +671,68 @@ fn caller_memory_at_a_destroyed_worlds_address_is_a_live_world() {
     // Else the check never ran: the allocator must hand the block back.
     assert_eq!(run.value("reuse: "), "reached", "the allocator never reused the destroyed world's block");
     run.assert_success();
+}
+
+/// `create(&a); destroy(a); create(&b)`, 200 times: the allocator hands b
+/// the block a had, and `a` must reach nothing (it reached b every time
+/// while a handle was the world's address).
+#[test]
+fn destroyed_handles_stay_dead_when_the_allocator_reuses_their_block() {
+    let run = reuse();
+    assert_eq!(run.value("destroyed handles that reached a world: "), "0 of 200");
+    run.assert_no_failures_in("destroyed handles while the allocator reuses blocks");
+}
+
+#[test]
+fn no_handle_value_is_handed_out_twice() {
+    let run = reuse();
+    assert_eq!(run.value("handle values repeated: "), "0 of 400");
+    run.assert_no_failures_in("handle values are never reused");
+}
+
+/// `init(m); deinit; init(m)`, and `init(m)` twice without a deinit: the
+/// earlier handle is refused, the new world works.
+#[test]
+fn handles_of_worlds_in_reused_caller_memory_stay_dead() {
+    let run = reuse();
+    run.assert_no_failures_in("deinitialised handles while the caller reuses memory");
+    run.assert_no_failures_in("a world whose memory mpca_world_init reused");
+}
+
+// --- Inputs at the edges of the model ----------------------------------------
+
+/// A 2D half-space keeps only the x and y of its normal: (1, 0, 5) gives
+/// the surface normal (1, 0, 0), and a particle bounces off it.
+#[test]
+fn half_space_normals_in_2d_lie_in_the_plane() {
+    let run = edges();
+    run.value("half-space: ");
+    run.assert_no_failures_in("2D half-space normal");
+}
+
+/// A vortex whose core radius squares to zero in float: no force at its
+/// centre, so a particle there keeps its velocity (it was stopped by
+/// 0 * inf = NaN).
+#[test]
+fn a_vortex_with_a_tiny_core_exerts_no_force_at_its_centre() {
+    let run = edges();
+    assert_eq!(run.values("vortex ").len(), 12, "{}", run.stdout);
+    run.assert_no_failures_in("vortex with a tiny core");
+}
+
+/// Every particle `mpca_world_cell` reports is accepted back by
+/// `mpca_world_add_particle_mass`, and the rebuilt world hashes equal, for
+/// 2D and 3D, 8- and 16-bit velocities; and the case met velocities that
+/// rounding took above 1.
+#[test]
+fn a_world_rebuilds_from_its_own_export() {
+    let run = edges();
+    let lines = run.values("rebuild ");
+    assert_eq!(lines.len(), 8, "{}", run.stdout);
+    for line in &lines {
+        assert!(line.contains(" 0 refused"), "{line}");
+    }
+    run.assert_no_failures_in("a world rebuilt from its own export");
 }
 
 /// The README's C example (its first ```c block), compiled with the same

@@ -13,7 +13,9 @@ pub fn root() -> &'static Path {
 }
 
 /// The directory holding `libmpca.a` and `libmpca.so`, built once per test
-/// process with the `panic-test` feature (for `mpca_debug_panic`).
+/// process with the `panic-test` feature (for `mpca_debug_panic`), in the
+/// `c-test` profile: release code with debug assertions and overflow checks,
+/// so that the C tests also meet Rust's checks of unsafe preconditions.
 ///
 /// A nested cargo, because the C programs need the real libraries: mpca-ffi
 /// is a staticlib and a cdylib with no rlib, so this crate cannot depend on
@@ -27,12 +29,12 @@ pub fn library() -> &'static Path {
         let cargo = std::env::var_os("CARGO").unwrap_or_else(|| env!("CARGO").into());
         let out = Command::new(cargo)
             .current_dir(root())
-            .args(["build", "--release", "-p", "mpca-ffi", "--features", "panic-test", "--target-dir"])
+            .args(["build", "--profile", "c-test", "-p", "mpca-ffi", "--features", "panic-test", "--target-dir"])
             .arg(&target_dir)
             .output()
             .expect("cargo runs");
         assert!(out.status.success(), "building libmpca failed:\n{}", String::from_utf8_lossy(&out.stderr));
-        let dir = target_dir.join("release");
+        let dir = target_dir.join("c-test");
         for lib in ["libmpca.a", "libmpca.so"] {
             assert!(dir.join(lib).is_file(), "{lib} missing from {}", dir.display());
         }
