@@ -41,6 +41,11 @@
 #define MPCA_VERSION_PATCH 0
 
 /**
+ * The most tasks mpca_world_step_parallel splits one step into.
+ */
+#define MPCA_MAX_TASKS 64
+
+/**
  * The result of every call. `MPCA_STATUS_OK` is 0; every other value names
  * one cause. Numbers are never reused: new causes get new numbers.
  */
@@ -83,6 +88,24 @@ enum mpca_status
    * The cell is not an obstacle surface cell.
    */
   MPCA_STATUS_NOT_A_SURFACE = 7,
+  /**
+   * The world is inside mpca_world_step_parallel: only
+   * mpca_world_step_task reaches it until that returns.
+   */
+  MPCA_STATUS_BUSY = 8,
+  /**
+   * The ticket is not the parallel step in flight on this world (a task
+   * of an earlier step, or no step in flight).
+   */
+  MPCA_STATUS_STALE_TASK = 9,
+  /**
+   * The task index is not below the step's task count.
+   */
+  MPCA_STATUS_TASK_INDEX = 10,
+  /**
+   * This task of the step was run already.
+   */
+  MPCA_STATUS_TASK_DONE = 11,
   /**
    * The dimension is neither 2 nor 3.
    */
@@ -588,6 +611,18 @@ typedef struct mpca_emitter {
 } mpca_emitter;
 
 /**
+ * The host's parallel-for, called once per step by
+ * mpca_world_step_parallel: it must call `mpca_world_step_task(world,
+ * ticket, i)` once for each `i` in `[0, count)`, in any order, on any of
+ * its threads (a job system, a thread pool, OpenMP, or a plain loop), and
+ * return once every call has returned.
+ */
+typedef void (*mpca_run_tasks)(struct mpca_world *world,
+                               uint64_t ticket,
+                               uint32_t count,
+                               void *user_data);
+
+/**
  * One particle.
  */
 typedef struct mpca_particle {
@@ -856,6 +891,38 @@ mpca_status mpca_world_surface(const struct mpca_world *world,
                                const uint32_t *pos,
                                float *out_normal,
                                float *out_restitution);
+
+/**
+ * Advances `steps` steps, each split into at most `max_tasks` tasks (0 and
+ * 1 mean one; at most MPCA_MAX_TASKS) that `run_tasks` runs, passing it
+ * `user_data`. The world is the one mpca_world_step gives, bit for bit,
+ * whatever the task count, the order or the threads.
+ *
+ * What may run concurrently: while this call runs, only
+ * mpca_world_step_task may be called on this world, from any thread and
+ * concurrently for distinct tasks; any other call on it (this one
+ * included, from another thread or from inside a task) returns
+ * `MPCA_STATUS_BUSY` and changes nothing. Other worlds are unaffected.
+ *
+ * A task the host did not run is run on this thread before the step ends,
+ * so a `run_tasks` that returns early still completes the step. Hosted
+ * builds only (the default `std` feature).
+ */
+mpca_status mpca_world_step_parallel(struct mpca_world *world,
+                                     uint64_t steps,
+                                     uint32_t max_tasks,
+                                     mpca_run_tasks run_tasks,
+                                     void *user_data);
+
+/**
+ * Runs task `index` of the parallel step with `ticket` (as `run_tasks`
+ * received them). Safe to call concurrently for distinct tasks of the
+ * step, from any threads. Refused, changing nothing: a task run already
+ * (`MPCA_STATUS_TASK_DONE`), an index not below the step's count
+ * (`MPCA_STATUS_TASK_INDEX`), a ticket of another step or a call when no
+ * step is in flight (`MPCA_STATUS_STALE_TASK`). Hosted builds only.
+ */
+mpca_status mpca_world_step_task(struct mpca_world *world, uint64_t ticket, uint32_t index);
 
 /**
  * Adds a particle of the world's mass at `pos` (3 values) with velocity

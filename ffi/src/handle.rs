@@ -16,7 +16,7 @@ use mpca_core::World;
 use crate::{mpca_status, mpca_world};
 
 #[cfg(feature = "std")]
-pub(crate) use hosted::{issue, reserve, resolve, revoke};
+pub(crate) use hosted::{begin_step, close_tasks, end_step, issue, open_tasks, reserve, resolve, revoke, run_task};
 
 #[cfg(not(feature = "std"))]
 pub(crate) use firmware::{issue, reserve, resolve, revoke};
@@ -29,27 +29,61 @@ mod hosted {
 
     use super::{mpca_status, mpca_world, World};
 
-    /// A live world: where it starts, how many bytes it spans, and whether
-    /// the library allocated it.
+    /// A live world: where it starts, how many bytes it spans, whether the
+    /// library allocated it, and whether a parallel step holds it.
     struct Entry {
         at: NonNull<u8>,
         bytes: usize,
         owned: bool,
+        step: Step,
     }
+
+    /// Where a world is in mpca_world_step_parallel (M11).
+    enum Step {
+        /// Not in it: every call may reach the world.
+        Idle,
+        /// In it, between the host's task runs: no call reaches the world.
+        Busy,
+        /// The host is running the tasks of one step: only
+        /// mpca_world_step_task with this step's ticket reaches it.
+        Tasks(Tasks),
+    }
+
+    /// The tasks of the step in flight.
+    struct Tasks {
+        ticket: u64,
+        count: usize,
+        /// Bit `i`: task `i` was handed out.
+        claimed: u64,
+        /// Tasks handed out and not yet returned.
+        running: u32,
+        task: TaskRef,
+    }
+
+    /// The step's task, its borrow's lifetime erased: it lives until
+    /// `close_tasks` returns, which waits until no task is running, and
+    /// `close_tasks` runs before the borrow ends.
+    #[derive(Clone, Copy)]
+    struct TaskRef(*const (dyn Fn(usize) + Sync + 'static));
 
     // SAFETY: the registry stores the address and hands it back; it never
     // reads or writes the world through it. Who uses the world, from which
-    // thread, is the C contract's business (one thread at a time).
+    // thread, is the C contract's business (one thread at a time), except
+    // during a parallel step, when the registry itself refuses every call
+    // but the step's tasks. The task pointer is called only as `TaskRef`
+    // says, and the task is `Sync`.
     unsafe impl Send for Entry {}
 
     struct Registry {
         /// How many handle numbers have been taken.
         taken: usize,
+        /// How many parallel steps' tickets have been issued.
+        tickets: u64,
         /// Live worlds by handle value.
         live: BTreeMap<usize, Entry>,
     }
 
-    static REGISTRY: Mutex<Registry> = Mutex::new(Registry { taken: 0, live: BTreeMap::new() });
+    static REGISTRY: Mutex<Registry> = Mutex::new(Registry { taken: 0, tickets: 0, live: BTreeMap::new() });
 
     fn registry() -> MutexGuard<'static, Registry> {
         // Every change below is one insert, remove or retain, so a panic
@@ -86,7 +120,7 @@ mod hosted {
     /// caller memory that held live worlds ends them: their handles are
     /// refused from now on.
     pub(crate) fn issue(number: Reserved, world: &mut World) -> *mut mpca_world {
-        let entry = Entry { at: NonNull::from(&mut *world).cast(), bytes: world.size_in_bytes(), owned: world.is_owned() };
+        let entry = Entry { at: NonNull::from(&mut *world).cast(), bytes: world.size_in_bytes(), owned: world.is_owned(), step: Step::Idle };
         let handle = value(number.0);
         let mut r = registry();
         if !entry.owned {
@@ -101,9 +135,107 @@ mod hosted {
     }
 
     /// Where the world of a live handle is; `BadHandle` for anything else,
-    /// found without reading any memory `handle` might point to.
+    /// found without reading any memory `handle` might point to, and `Busy`
+    /// while a parallel step holds the world.
     pub(crate) fn resolve(handle: *const mpca_world) -> Result<*mut u8, mpca_status> {
-        registry().live.get(&handle.addr()).map(|e| e.at.as_ptr()).ok_or(mpca_status::BadHandle)
+        let r = registry();
+        let e = r.live.get(&handle.addr()).ok_or(mpca_status::BadHandle)?;
+        match e.step {
+            Step::Idle => Ok(e.at.as_ptr()),
+            _ => Err(mpca_status::Busy),
+        }
+    }
+
+    /// Starts a parallel step on a live, idle world: every other call on
+    /// it is refused with `Busy` until [`end_step`].
+    pub(crate) fn begin_step(handle: *const mpca_world) -> Result<*mut u8, mpca_status> {
+        let mut r = registry();
+        let e = r.live.get_mut(&handle.addr()).ok_or(mpca_status::BadHandle)?;
+        match e.step {
+            Step::Idle => {
+                e.step = Step::Busy;
+                Ok(e.at.as_ptr())
+            }
+            _ => Err(mpca_status::Busy),
+        }
+    }
+
+    /// Ends the parallel step [`begin_step`] started.
+    pub(crate) fn end_step(handle: *const mpca_world) {
+        if let Some(e) = registry().live.get_mut(&handle.addr()) {
+            e.step = Step::Idle;
+        }
+    }
+
+    /// Hands the tasks of one step to mpca_world_step_task and returns
+    /// the step's ticket. [`close_tasks`] must follow before `task` is
+    /// dropped.
+    pub(crate) fn open_tasks(handle: *const mpca_world, count: usize, task: &(dyn Fn(usize) + Sync)) -> u64 {
+        let mut r = registry();
+        r.tickets += 1;
+        let ticket = r.tickets;
+        // SAFETY: only the lifetime is erased; close_tasks, which the caller
+        // runs before `task`'s borrow ends, takes the pointer back and waits
+        // until no call through it is running.
+        let task: *const (dyn Fn(usize) + Sync + 'static) = unsafe { core::mem::transmute(task) };
+        if let Some(e) = r.live.get_mut(&handle.addr()) {
+            e.step = Step::Tasks(Tasks { ticket, count, claimed: 0, running: 0, task: TaskRef(task) });
+        }
+        ticket
+    }
+
+    /// Takes the step's tasks back once none is running: later calls of
+    /// mpca_world_step_task with its ticket are refused.
+    pub(crate) fn close_tasks(handle: *const mpca_world) {
+        loop {
+            {
+                let mut r = registry();
+                let Some(e) = r.live.get_mut(&handle.addr()) else { return };
+                if !matches!(&e.step, Step::Tasks(t) if t.running > 0) {
+                    e.step = Step::Busy;
+                    return;
+                }
+            }
+            std::thread::yield_now();
+        }
+    }
+
+    /// Runs task `index` of the step with `ticket`, once: `StaleTask` when
+    /// that step is not in flight on this world, `TaskIndex` beyond its
+    /// tasks, `TaskDone` for a task handed out before.
+    pub(crate) fn run_task(handle: *const mpca_world, ticket: u64, index: u32) -> Result<(), mpca_status> {
+        let task = {
+            let mut r = registry();
+            let e = r.live.get_mut(&handle.addr()).ok_or(mpca_status::BadHandle)?;
+            let Step::Tasks(t) = &mut e.step else { return Err(mpca_status::StaleTask) };
+            if t.ticket != ticket {
+                return Err(mpca_status::StaleTask);
+            }
+            let i = index as usize;
+            if i >= t.count {
+                return Err(mpca_status::TaskIndex);
+            }
+            if t.claimed >> i & 1 != 0 {
+                return Err(mpca_status::TaskDone);
+            }
+            t.claimed |= 1 << i;
+            t.running += 1;
+            t.task
+        };
+        /// Counts the task as returned, even if it unwinds.
+        struct Returned(*const mpca_world);
+        impl Drop for Returned {
+            fn drop(&mut self) {
+                if let Some(Entry { step: Step::Tasks(t), .. }) = registry().live.get_mut(&self.0.addr()) {
+                    t.running -= 1;
+                }
+            }
+        }
+        let _returned = Returned(handle);
+        // SAFETY: `running` counts this call, so close_tasks waits for it and
+        // the task is alive (TaskRef).
+        unsafe { (*task.0)(index as usize) };
+        Ok(())
     }
 
     /// Ends a handle: it is refused from now on.

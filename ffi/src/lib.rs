@@ -19,7 +19,9 @@
 //!   without it (firmware builds, which abort on panic by target default) a
 //!   panic halts in a spin loop. No input is meant to panic: a panic is a bug.
 //! - **Threads**: a world may move between threads but must not be used
-//!   from two at once.
+//!   from two at once, except for the tasks of a parallel step
+//!   (`parallel.rs`), during which the registry refuses every other call on
+//!   the world with `MPCA_STATUS_BUSY`.
 #![no_std]
 #![deny(missing_docs)]
 #![allow(non_camel_case_types)]
@@ -33,6 +35,8 @@ mod emitters;
 mod forces;
 mod handle;
 mod obstacles;
+#[cfg(feature = "std")]
+mod parallel;
 mod particles;
 mod status;
 mod world;
@@ -41,6 +45,8 @@ pub use desc::*;
 pub use emitters::*;
 pub use forces::*;
 pub use obstacles::*;
+#[cfg(feature = "std")]
+pub use parallel::*;
 pub use particles::*;
 pub use status::*;
 pub use world::*;

@@ -28,6 +28,16 @@ pub enum mpca_status {
     OutputTooSmall = 6,
     /// The cell is not an obstacle surface cell.
     NotASurface = 7,
+    /// The world is inside mpca_world_step_parallel: only
+    /// mpca_world_step_task reaches it until that returns.
+    Busy = 8,
+    /// The ticket is not the parallel step in flight on this world (a task
+    /// of an earlier step, or no step in flight).
+    StaleTask = 9,
+    /// The task index is not below the step's task count.
+    TaskIndex = 10,
+    /// This task of the step was run already.
+    TaskDone = 11,
     /// The dimension is neither 2 nor 3.
     BadDimension = 100,
     /// 3D worlds are not built into this library.
@@ -154,6 +164,10 @@ impl mpca_status {
             S::BadEnum => c"an enumeration or flag field holds an unknown value",
             S::OutputTooSmall => c"the output buffer is too small; the count needed was written",
             S::NotASurface => c"the cell is not an obstacle surface cell",
+            S::Busy => c"the world is in a parallel step; only its tasks may run until it returns",
+            S::StaleTask => c"the ticket is not the parallel step in flight on this world",
+            S::TaskIndex => c"the task index is not below the step's task count",
+            S::TaskDone => c"this task of the step was run already",
             S::BadDimension => c"dimension must be 2 or 3",
             S::Dim3Disabled => c"3D worlds are not built into this library",
             S::SizeZero => c"a world size is zero",
@@ -204,8 +218,9 @@ pub extern "C" fn mpca_status_message(status: u32) -> *const c_char {
 /// The status numbered `n`, if there is one.
 pub(crate) fn status_from_u32(n: u32) -> Option<mpca_status> {
     use mpca_status as S;
-    const ALL: [mpca_status; 41] = [
+    const ALL: [mpca_status; 45] = [
         S::Ok, S::NullPointer, S::BadHandle, S::Panic, S::BadStructSize, S::BadEnum, S::OutputTooSmall, S::NotASurface,
+        S::Busy, S::StaleTask, S::TaskIndex, S::TaskDone,
         S::BadDimension, S::Dim3Disabled, S::SizeZero, S::SizeOdd, S::TooLarge, S::PeriodicMismatch,
         S::NotFinite, S::NegativeDt, S::BadVortex, S::RestitutionRange, S::MassRange, S::SpeedRange,
         S::Q16Disabled, S::FeatureDisabled, S::NotEnabled, S::CapacityRange, S::BufferTooSmall,

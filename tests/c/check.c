@@ -68,6 +68,8 @@ static const struct symbol {
     SYMBOL(mpca_world_create),
     SYMBOL(mpca_world_destroy),
     SYMBOL(mpca_world_step),
+    SYMBOL(mpca_world_step_parallel),
+    SYMBOL(mpca_world_step_task),
     SYMBOL(mpca_world_desc),
     SYMBOL(mpca_world_stats),
     SYMBOL(mpca_world_hash),

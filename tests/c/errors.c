@@ -1145,6 +1145,10 @@ static const struct {
     STATUS(MPCA_STATUS_BAD_ENUM),
     STATUS(MPCA_STATUS_OUTPUT_TOO_SMALL),
     STATUS(MPCA_STATUS_NOT_A_SURFACE),
+    STATUS(MPCA_STATUS_BUSY),
+    STATUS(MPCA_STATUS_STALE_TASK),
+    STATUS(MPCA_STATUS_TASK_INDEX),
+    STATUS(MPCA_STATUS_TASK_DONE),
     STATUS(MPCA_STATUS_BAD_DIMENSION),
     STATUS(MPCA_STATUS_DIM3_DISABLED),
     STATUS(MPCA_STATUS_SIZE_ZERO),
@@ -1195,7 +1199,7 @@ static void message_cases(void) {
             CHECK(messages[j] == NULL || strcmp(messages[i], messages[j]) != 0);
         }
     }
-    const uint32_t unknown[] = {8, 99, 130, 133, 198, 200, 1000, 0x7fffffffu, UINT32_MAX};
+    const uint32_t unknown[] = {12, 99, 130, 133, 198, 200, 1000, 0x7fffffffu, UINT32_MAX};
     const char *first = TRACE(mpca_status_message(unknown[0]));
     CHECK(first != NULL && first[0] != '\0');
     for (unsigned i = 0; i < sizeof unknown / sizeof unknown[0] && first != NULL; i++) {

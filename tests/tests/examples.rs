@@ -354,3 +354,16 @@ fn every_program_documents_and_checks_its_options() {
         }
     }
 }
+
+/// `c_examples/threads.c`: the 1024^2 gas stepped on 1, 2 and 3 POSIX
+/// threads of the program's own pool (mpca_world_step_parallel) hashes
+/// equal to the serial step; the program says so and exits 1 otherwise.
+#[test]
+fn the_threads_example_equals_the_serial_step() {
+    for threads in ["1", "2", "3"] {
+        let out = run("threads", &["--threads", threads, "--steps", "3"]);
+        assert!(out.contains("particles=") && out.contains("equal=yes"), "{threads} threads:\n{out}");
+    }
+    let version = run("threads", &["--version"]);
+    assert!(version.starts_with("threads (libmpca "), "{version}");
+}
