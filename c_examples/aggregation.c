@@ -16,6 +16,7 @@
 static mpca_world *build(const scene_opts *o) {
     mpca_desc d;
     mpca_check(mpca_desc_defaults(&d, 2, o->size, o->size, 0), "mpca_desc_defaults");
+    d.drift = MPCA_DRIFT_PAPER; /* the paper's rule, as printed */
     d.restitution = RESTITUTION; /* periodic on every face: the defaults */
     d.seed = o->seed;
     mpca_world *w = world_create(&d);

@@ -13,6 +13,7 @@
 static mpca_world *build(const scene_opts *o) {
     mpca_desc d;
     mpca_check(mpca_desc_defaults(&d, 2, o->size, o->size, 0), "mpca_desc_defaults");
+    d.drift = MPCA_DRIFT_PAPER; /* the paper's rule, as printed */
     for (int axis = 0; axis < 2; axis++) {
         d.boundary[axis][0] = d.boundary[axis][1] = MPCA_BOUNDARY_WALL;
     }

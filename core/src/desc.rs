@@ -151,7 +151,9 @@ pub struct Description {
 impl Description {
     /// A 2D world of `nx x ny` cells: periodic on every axis, one mass of 1,
     /// no obstacles, no force, `e = 1`, `dt = 1`, 8-bit velocities, the
-    /// paper's drift rule and collisions, and the exact-fast assignment.
+    /// calibrated drift rule (a free particle drifts at its velocity; set
+    /// `Drift::Paper` to reproduce the paper), the paper's collisions and
+    /// the exact-fast assignment.
     pub const fn new_2d(nx: u32, ny: u32) -> Self {
         Description {
             dim: 2,
@@ -170,7 +172,7 @@ impl Description {
             dt: 1.0,
             seed: 0,
             quantization: Quantization::Bits8,
-            drift: Drift::Paper,
+            drift: Drift::Calibrated,
             method: Method::ExactFast,
             collisions: Collisions::Paper,
             contacts: false,

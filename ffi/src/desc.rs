@@ -243,8 +243,9 @@ impl mpca_desc {
 
 /// Fills `out` with the defaults for a `dim`-dimensional world of
 /// `nx x ny (x nz)` cells: periodic faces, one mass of 1, no obstacles, no
-/// force, e = 1, dt = 1, seed 0, 8-bit velocities, the paper's drift rule
-/// and collisions, the exact-fast assignment, no emitters. Sets `struct_size`. Sizes are
+/// force, e = 1, dt = 1, seed 0, 8-bit velocities, the calibrated drift
+/// rule (MPCA_DRIFT_PAPER reproduces the paper), the paper's collisions,
+/// the exact-fast assignment, no emitters. Sets `struct_size`. Sizes are
 /// checked later, by mpca_world_bytes and mpca_world_init.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_desc_defaults(out: *mut mpca_desc, dim: u32, nx: u32, ny: u32, nz: u32) -> mpca_status {

@@ -35,6 +35,7 @@ fn setup_rng(world: &World) -> Pcg32 {
 /// uniform.
 pub fn aggregation() -> Scene {
     let mut desc = Description::new_2d(128, 128);
+    desc.drift = Drift::Paper; // the paper's rule, as printed
     desc.restitution = 0.5;
     desc.seed = 41;
     Scene { name: "aggregation", section: "4.1", desc, steps: 800, paper_seconds: 800.0, setup: fill_aggregation }
@@ -65,6 +66,7 @@ fn fill_gas(w: &mut World, nx: u32, ny: u32) -> Result<(), Error> {
 /// Walls all round, so nothing leaves.
 pub fn cluster() -> Scene {
     let mut desc = Description::new_2d(128, 128).with_boundary(Boundary::Wall);
+    desc.drift = Drift::Paper; // the paper's rule, as printed
     desc.restitution = 1.0;
     desc.mass = 1.0;
     desc.seed = 42;
@@ -90,6 +92,7 @@ fn fill_cluster(w: &mut World) -> Result<(), Error> {
 /// force, e = 1, one mass, 120 steps. A wall below, open on the other faces.
 pub fn smoke() -> Scene {
     let mut desc = Description::new_2d(128, 128).with_boundary(Boundary::Open);
+    desc.drift = Drift::Paper; // the paper's rule, as printed
     desc.boundary[1][0] = Boundary::Wall;
     desc.restitution = 1.0;
     desc.forces.vortex = true;
@@ -117,6 +120,7 @@ fn fill_smoke(w: &mut World) -> Result<(), Error> {
 /// gives no rate) pours 16 particles a step from an 8 x 8 patch.
 pub fn water() -> Scene {
     let mut desc = Description::new_3d(64, 64, 64).with_boundary(Boundary::Wall);
+    desc.drift = Drift::Paper; // the paper's rule, as printed
     desc.restitution = 1.0;
     desc.forces.uniform = true;
     desc.gravity = [0.0, -0.02, 0.0];

@@ -94,19 +94,20 @@ fn poured(scene: &Scene, steps: u64) -> (f64, f64) {
 
 /// M5.7: under the paper's rules a particle pressing on a resting
 /// neighbour keeps its stored speed, so a pool never rests and the clamp
-/// fires on a fifth of the particle-steps (g = 0.01, e = 0.5: measured mean
-/// |v| 0.32, 0.209 clamps per particle-step). With contacts the pressing
-/// particle hands its momentum down the pile: clamps fall below 1 % of the
-/// particle-steps (measured 0.0002) and the pool moves at half the speed
-/// (0.16). It does not come fully to rest: momentum leaves a resting
-/// particle only when it tries a move, at a rate proportional to its
-/// speed, so a pile of depth h keeps speeds near sqrt(h g) (docs/model.md,
-/// M5.7).
+/// keeps firing (g = 0.01, e = 0.5, the default calibrated drift: measured
+/// mean |v| 0.22, 0.069 clamps per particle-step; 0.32 and 0.209 under the
+/// paper's drift rule). With contacts the pressing particle hands its
+/// momentum down the pile: clamps fall below 1 % of the particle-steps
+/// (measured 0, and 0.0002 under the paper's drift) and the pool moves at
+/// about half the speed (0.12). It does not come fully to rest: momentum
+/// leaves a resting particle only when it tries a move, at a rate that
+/// grows with its speed, so a pile of depth h keeps speeds near sqrt(h g)
+/// (docs/model.md, M5.7).
 #[test]
 fn contacts_let_a_pool_settle() {
     let (paper_speed, paper_clamps) = poured(&pool(false, 0.01, 0.5), 1200);
     let (speed, clamps) = poured(&pool(true, 0.01, 0.5), 1200);
-    assert!(paper_clamps > 0.1, "{paper_clamps}");
+    assert!(paper_clamps > 0.03, "{paper_clamps}");
     assert!(clamps <= 0.01, "clamps per particle-step {clamps}");
     assert!(speed < 0.6 * paper_speed, "mean |v| {speed} against the paper's {paper_speed}");
 }
@@ -149,3 +150,4 @@ fn contacts_keep_momentum_up_to_rounding() {
     assert!(after.displaced > 2_000, "refused moves, and so contacts, happen: {after:?}");
     assert_eq!(after.clamps, 0, "a clamp would change momentum beyond rounding");
 }
+

@@ -436,10 +436,10 @@ fn recommend(h: &Headline) -> String {
     let (p3, c3, _, t3) = h.drift[1];
     if c2 < p2 / 2.0 && c3 < p3 / 2.0 && t2 < 1.15 && t3 < 1.15 {
         s += &format!(
-            "- **`Drift::Calibrated` should be the default.** Its free-flight drift error is {} (2D) and {} (3D) against the \
+            "- **`Drift::Calibrated` is the default.** Its free-flight drift error is {} (2D) and {} (3D) against the \
              paper rule's {} and {}, at the same cost ({}× and {}× the run time): the paper's rule moves a particle of \
              speed v at p/(2−p), up to half as fast as asked, and bends paths off their velocity. `Drift::Paper` stays \
-             for reproducing the paper's figures.\n",
+             for reproducing the paper's figures; the paper's scenes set it.\n",
             pct(c2),
             pct(c3),
             pct(p2),
