@@ -37,6 +37,7 @@ typedef struct scene_opts {
     uint32_t px;     /* frame size in pixels (2D: rounded down to whole cells) */
     const char *out; /* output folder */
     const char *name; /* file name prefix */
+    uint32_t threads; /* 0: mpca_world_step; else the parallel step on this many threads */
 } scene_opts;
 
 /* What one drawing call renders into: the pixel size of the image and, in

@@ -4,10 +4,9 @@
 //!
 //! The library starts no thread: `World::step_parallel` hands the step's
 //! tasks to a parallel-for of the caller's, here scoped threads of the
-//! standard library taking tasks from a shared counter (what
-//! `World::step_threads` does). The worlds must end with the same hash.
+//! standard library that split the tasks between them round-robin. The
+//! worlds must end with the same hash.
 
-use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
 use mpca::{Description, World};
@@ -32,22 +31,16 @@ fn main() -> Result<(), mpca::Error> {
     serial.step(steps as u64);
     let serial_time = start.elapsed();
 
-    // The host's parallel-for: `threads` threads pull task indices from a
-    // counter until none is left, and the call returns when all are done.
+    // The host's parallel-for: thread t of `threads` runs tasks t,
+    // t + threads, t + 2 threads, ... and the call returns when all are
+    // done. (World::step_threads instead lets threads take the next task
+    // as they finish one.)
     let mut host = |count: usize, task: &(dyn Fn(usize) + Sync)| {
-        let next = AtomicUsize::new(0);
-        let work = || loop {
-            let i = next.fetch_add(1, Ordering::Relaxed);
-            if i >= count {
-                break;
-            }
-            task(i);
-        };
         std::thread::scope(|s| {
-            for _ in 1..threads {
-                s.spawn(work);
+            for t in 1..threads.min(count) {
+                s.spawn(move || (t..count).step_by(threads).for_each(task));
             }
-            work();
+            (0..count).step_by(threads).for_each(task);
         });
     };
     let start = Instant::now();

@@ -319,7 +319,8 @@ fn water_small_run_draws_the_sphere_the_box_and_the_water() {
 
 /// Each program at the paper's size for a few steps: the same world, bit for
 /// bit (`mpca_world_hash` against `World::state_hash`), as the scene of
-/// tests/src/scenes.rs after the same steps.
+/// tests/src/scenes.rs after the same steps; stepped serially, and in the
+/// parallel step (M11) on 1, 2 and 3 POSIX threads (4, 8 and 12 tasks).
 #[test]
 fn the_c_scenes_are_the_rust_scenes() {
     const STEPS: u64 = 6;
@@ -328,15 +329,21 @@ fn the_c_scenes_are_the_rust_scenes() {
     let scenes: Vec<Scene> = paper_scenes().into();
     let mut memory = Vec::new();
     for scene in &scenes {
-        let stdout = run(scene.name, &["--steps", &STEPS.to_string(), "--every", "0", "--tiles", "1", "--out", &out_s]);
-        let line = stdout.lines().find(|l| l.starts_with("end: ")).expect("an end: line");
-        let f = fields(line);
         let world = build(scene, &mut memory).expect("the Rust scene builds");
         world.step(STEPS);
-        assert_eq!(number::<u64>(&f, "step", line), STEPS, "{}", scene.name);
-        assert_eq!(number::<u64>(&f, "particles", line), world.particle_count(), "{}: particles", scene.name);
-        let hash = u64::from_str_radix(f["hash"], 16).expect("a hex hash");
-        assert_eq!(hash, world.state_hash(), "{}: C {hash:016x}, Rust {:016x}", scene.name, world.state_hash());
+        for threads in [None, Some("1"), Some("2"), Some("3")] {
+            let steps = STEPS.to_string();
+            let mut args = vec!["--steps", &steps, "--every", "0", "--tiles", "1", "--out", &out_s];
+            args.extend(threads.map(|t| ["--threads", t]).into_iter().flatten());
+            let stdout = run(scene.name, &args);
+            let line = stdout.lines().find(|l| l.starts_with("end: ")).expect("an end: line");
+            let f = fields(line);
+            let what = format!("{} ({} threads)", scene.name, threads.unwrap_or("no"));
+            assert_eq!(number::<u64>(&f, "step", line), STEPS, "{what}");
+            assert_eq!(number::<u64>(&f, "particles", line), world.particle_count(), "{what}: particles");
+            let hash = u64::from_str_radix(f["hash"], 16).expect("a hex hash");
+            assert_eq!(hash, world.state_hash(), "{what}: C {hash:016x}, Rust {:016x}", world.state_hash());
+        }
     }
 }
 
@@ -344,11 +351,12 @@ fn the_c_scenes_are_the_rust_scenes() {
 fn every_program_documents_and_checks_its_options() {
     for scene in ["aggregation", "cluster", "smoke", "water"] {
         let help = run(scene, &["--help"]);
-        for option in ["--size N", "--steps N", "--seed N", "--every N", "--tiles N", "--px N", "--out DIR", "--name S"]
+        for option in
+            ["--size N", "--steps N", "--seed N", "--every N", "--tiles N", "--px N", "--out DIR", "--name S", "--threads N"]
         {
             assert!(help.contains(option), "{scene} --help does not mention {option}:\n{help}");
         }
-        for bad in [&["--size", "7"][..], &["--steps", "-1"], &["--bogus"], &["--every"]] {
+        for bad in [&["--size", "7"][..], &["--steps", "-1"], &["--bogus"], &["--every"], &["--threads", "0"], &["--threads", "17"]] {
             let out = Command::new(programs().join(scene)).args(bad).output().expect("runs");
             assert_eq!(out.status.code(), Some(2), "{scene} {bad:?} should be refused");
         }
