@@ -226,7 +226,9 @@ fn clamp_counted(x: &mut [f32; 3], scale: f32, m: f32, counters: &mut Counters) 
 #[cold]
 fn count_clamp(s2: f32, m: f32, counters: &mut Counters) {
     counters.clamps += 1;
-    let fixed = (0.5 * f64::from(m) * (f64::from(s2) - 1.0) * ENERGY_SCALE) as u128; // saturating cast
+    // f32 and a saturating cast: no f64 or 128-bit arithmetic, which small
+    // cores emulate; f32's 24 bits are far finer than the statistic needs.
+    let fixed = (0.5 * m * (s2 - 1.0) * ENERGY_SCALE as f32) as u64;
     counters.clamp_energy = counters.clamp_energy.saturating_add(fixed);
 }
 
@@ -688,10 +690,10 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
     }
 }
 
-impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> BlockSink for Kernel<'_, Q, D, CELLS, GENERAL> {
+impl<'a, Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> BlockSink<'a> for Kernel<'a, Q, D, CELLS, GENERAL> {
     const CELLS: usize = CELLS;
 
-    fn index(&self) -> Index<'_> {
+    fn index(&self) -> Index<'a> {
         Index { occupancy: self.planes.occupancy, rows: self.planes.rows, words: self.planes.words }
     }
 

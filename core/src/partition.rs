@@ -122,13 +122,14 @@ pub(crate) struct Index<'a> {
     pub words: Cells<'a, u64>,
 }
 
-/// What the sweep hands each occupied block to.
-pub(crate) trait BlockSink {
+/// What the sweep hands each occupied block to; `'a` is the borrow of the
+/// planes.
+pub(crate) trait BlockSink<'a> {
     /// Cells of a block: 4 in 2D, 8 in 3D.
     const CELLS: usize;
     /// The planes the sweep reads and the summaries it keeps, read between
     /// visits.
-    fn index(&self) -> Index<'_>;
+    fn index(&self) -> Index<'a>;
     /// Processes block `bx` of `row`, whose lowest corner has x `x0` and
     /// whose cells holding a particle are the set bits of `occ` (bit `c` for
     /// cell `c`, never a cell beyond a face).
@@ -234,7 +235,8 @@ impl Partition {
     ///
     /// The flags and summaries of rows outside the band are neither read
     /// nor written, so bands can be swept at the same time (M11).
-    pub fn sweep_band<S: BlockSink>(&self, sink: &mut S, band: Range<usize>, reverse: bool, skip: bool) {
+    pub fn sweep_band<'a, S: BlockSink<'a>>(&self, sink: &mut S, band: Range<usize>, reverse: bool, skip: bool) {
+        let idx = sink.index();
         let [ax, ay, az] = self.axes;
         let layers = if self.dim == 3 { 2 } else { 1 };
         let total = band.len();
@@ -244,7 +246,7 @@ impl Partition {
             let (by, bz) = (i % ay.blocks, i / ay.blocks);
             // Rows of blocks from i to the band's edge, i included.
             let room = if reverse { i - band.start + 1 } else { band.end - i };
-            let run = if skip { self.empty_run(sink.index().rows, by, bz, reverse, room) } else { 0 };
+            let run = if skip { self.empty_run(idx.rows, by, bz, reverse, room) } else { 0 };
             if run > 0 {
                 j += run;
                 continue;
@@ -266,11 +268,11 @@ impl Partition {
                     row.line[r] = line;
                     row.word[r] = line * self.row_words;
                     row.cell[r] = line * ax.n;
-                    flagged |= sink.index().rows.get(line) != 0;
+                    flagged |= idx.rows.get(line) != 0;
                 }
             }
             if flagged || !skip {
-                self.sweep_row(sink, &row, reverse, skip);
+                self.sweep_row(sink, idx, &row, reverse, skip);
             }
         }
     }
@@ -319,10 +321,10 @@ impl Partition {
         m
     }
 
-    fn sweep_row<S: BlockSink>(&self, sink: &mut S, row: &BlockRow, reverse: bool, skip: bool) {
+    fn sweep_row<'a, S: BlockSink<'a>>(&self, sink: &mut S, idx: Index<'a>, row: &BlockRow, reverse: bool, skip: bool) {
         match S::CELLS {
-            4 => self.sweep_row_of::<S, 2>(sink, row, reverse, skip),
-            _ => self.sweep_row_of::<S, 4>(sink, row, reverse, skip),
+            4 => self.sweep_row_of::<S, 2>(sink, idx, row, reverse, skip),
+            _ => self.sweep_row_of::<S, 4>(sink, idx, row, reverse, skip),
         }
     }
 
@@ -332,7 +334,7 @@ impl Partition {
     /// Blocks only change their own cells, so a word read before a block
     /// was visited still holds the right bits for every later block.
     #[inline(always)]
-    fn sweep_row_of<S: BlockSink, const ROWS: usize>(&self, sink: &mut S, row: &BlockRow, reverse: bool, skip: bool) {
+    fn sweep_row_of<'a, S: BlockSink<'a>, const ROWS: usize>(&self, sink: &mut S, idx: Index<'a>, row: &BlockRow, reverse: bool, skip: bool) {
         let ax = self.axes[0];
         let words = self.row_words;
         let sw = self.summary_words;
@@ -352,7 +354,7 @@ impl Partition {
         // index 1.
         let half = self.offset == 1 && !ax.periodic;
         let half_block = |sink: &mut S| {
-            let first = Self::words::<ROWS>(sink.index().occupancy, row, 0).map(|m| (m & 1) << 1);
+            let first = Self::words::<ROWS>(idx.occupancy, row, 0).map(|m| (m & 1) << 1);
             let bits = block(&first, 0);
             if bits != 0 {
                 sink.visit(row, -1, 0, bits);
@@ -362,7 +364,7 @@ impl Partition {
         // row a word with a particle is seen in, and by the blocks for every
         // row a particle moves into.
         for r in (0..ROWS).filter(|&r| inside(r)) {
-            sink.index().rows.set(row.line[r], 0);
+            idx.rows.set(row.line[r], 0);
         }
         let mut seen = [0u64; ROWS];
         if half && !reverse {
@@ -371,7 +373,7 @@ impl Partition {
         // Cell nx (one past the end) is cell 0 when periodic: read it before
         // any block of the row is visited (only the wrapping block holds it).
         let wrap = if self.offset == 1 && ax.periodic {
-            Self::words::<ROWS>(sink.index().occupancy, row, 0).map(|m| m & 1)
+            Self::words::<ROWS>(idx.occupancy, row, 0).map(|m| m & 1)
         } else {
             [0; ROWS]
         };
@@ -381,14 +383,14 @@ impl Partition {
             // The words to sweep: those that may hold a particle, and at
             // offset 1 those before them (the pair 64w + 63, 64w + 64 lies
             // across two words, and the last word's pair wraps to cell 0).
-            let mut todo = summary(&sink.index(), k);
+            let mut todo = summary(&idx, k);
             if !skip {
                 // Every word of the row.
                 let count = (words - 64 * k).min(64);
                 todo = u64::MAX >> (64 - count);
             }
             if self.offset == 1 {
-                let next = if k + 1 < sw { summary(&sink.index(), k + 1) & 1 } else { 0 };
+                let next = if k + 1 < sw { summary(&idx, k + 1) & 1 } else { 0 };
                 todo |= todo >> 1 | next << 63;
                 if last >> 6 == k && wrap.iter().any(|&b| b != 0) {
                     todo |= 1 << (last & 63);
@@ -398,7 +400,6 @@ impl Partition {
                 let b = if reverse { 63 - todo.leading_zeros() } else { todo.trailing_zeros() } as usize;
                 todo &= !(1u64 << b);
                 let w = 64 * k + b;
-                let idx = sink.index();
                 let mut m = Self::words::<ROWS>(idx.occupancy, row, w);
                 for r in (0..ROWS).filter(|&r| inside(r)) {
                     seen[r] |= m[r];
@@ -438,7 +439,7 @@ impl Partition {
             half_block(sink);
         }
         for r in (0..ROWS).filter(|&r| inside(r) && seen[r] != 0) {
-            sink.index().rows.set(row.line[r], 1);
+            idx.rows.set(row.line[r], 1);
         }
     }
 }

@@ -52,7 +52,8 @@ pub struct Stats {
     pub collisions: u64,
     /// Velocities scaled back to `|v| = 1` (M5.5), all steps.
     pub clamps: u64,
-    /// Kinetic energy those clamps removed, all steps.
+    /// Kinetic energy those clamps removed, all steps (counted in steps of
+    /// 2^-32, saturating at 2^32).
     pub clamp_energy: f64,
     /// Particles not placed in their desired cell (M5.6), all steps.
     pub displaced: u64,

@@ -23,7 +23,7 @@ pub(crate) struct Counters {
     pub shortfall: u64,
     pub collisions: u64,
     pub clamps: u64,
-    pub clamp_energy: u128,
+    pub clamp_energy: u64,
     pub displaced: u64,
     pub processed: u64,
     pub skipped: u64,
@@ -42,7 +42,8 @@ impl Counters {
     }
 }
 
-/// 2^32, the scale of the clamped-energy accumulator.
+/// 2^32, the scale of the clamped-energy accumulator (which saturates at
+/// 2^32 energy units).
 pub(crate) const ENERGY_SCALE: f64 = 4_294_967_296.0;
 
 #[repr(C)]
