@@ -567,6 +567,12 @@ typedef struct mpca_desc {
    * it, head on (M5.7), so piles come to rest. 0: the paper's rules.
    */
   uint32_t contacts;
+  /**
+   * 1: collisions and contacts give back the kinetic energy rounding
+   * adds on average (M1b), so an elastic world keeps its energy. 0:
+   * unbiased rounding only.
+   */
+  uint32_t energy_neutral;
 } mpca_desc;
 
 /**

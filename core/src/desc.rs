@@ -141,6 +141,11 @@ pub struct Description {
     /// come to rest. Off: the paper's rules, where a refused particle keeps
     /// its velocity.
     pub contacts: bool,
+    /// M1b (beyond the paper): each collision and contact shrinks its
+    /// pair's relative velocity by the kinetic energy the stochastic
+    /// rounding of its results adds on average, so an elastic world keeps
+    /// its energy. Off: unbiased rounding, which heats an elastic world.
+    pub energy_neutral: bool,
     /// How many emitters fit.
     pub emitter_capacity: u32,
     /// Whether particles carry a remaining lifetime (a `u16` per cell), so
@@ -176,6 +181,7 @@ impl Description {
             method: Method::ExactFast,
             collisions: Collisions::Paper,
             contacts: false,
+            energy_neutral: false,
             emitter_capacity: 0,
             lifetimes: false,
         }

@@ -38,7 +38,7 @@
 
 use crate::assign::{assign_moves, optimal_moves_2d, pick_move, Method, MoveProblem, PLACE_2D};
 use crate::cells::Cells;
-use crate::collision::{block_pairs, collide_limited, collide_pair, pair_holds_two, random_unit, shares};
+use crate::collision::{block_pairs, collide_limited, collide_pair, energy_neutral, pair_holds_two, random_unit, shares};
 use crate::desc::{Collisions, Description};
 use crate::force::ForceTerms;
 use crate::obstacle::{reflect, surface_at, Surface};
@@ -355,6 +355,9 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
             // quantum per component) cannot store a speed above 1 either.
             Collisions::SpeedLimited => collide_limited::<D>(va, vc, s, e, Q::SCALE - ROUNDING_MARGIN[D - 2], rng),
         };
+        if self.shared.desc.energy_neutral {
+            (xa, xc) = energy_neutral(xa, xc, s);
+        }
         self.counters.collisions += 1;
         clamp_counted(&mut xa, Q::SCALE, ma, &mut self.counters);
         clamp_counted(&mut xc, Q::SCALE, mc, &mut self.counters);
@@ -484,6 +487,9 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
             let (ma, mh) = (mass(a), mass(h));
             let s = if equal { (0.5, 0.5) } else { shares(ma, mh) };
             let (mut ya, mut yh) = collide_pair(xa, xh, s, self.shared.desc.restitution, r);
+            if self.shared.desc.energy_neutral {
+                (ya, yh) = energy_neutral(ya, yh, s);
+            }
             clamp_counted(&mut ya, Q::SCALE, ma, &mut self.counters);
             clamp_counted(&mut yh, Q::SCALE, mh, &mut self.counters);
             b.set(a, ya);

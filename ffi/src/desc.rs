@@ -120,6 +120,10 @@ pub struct mpca_desc {
     /// 1: a particle refused the cell it wanted meets the particle holding
     /// it, head on (M5.7), so piles come to rest. 0: the paper's rules.
     pub contacts: u32,
+    /// 1: collisions and contacts give back the kinetic energy rounding
+    /// adds on average (M1b), so an elastic world keeps its energy. 0:
+    /// unbiased rounding only.
+    pub energy_neutral: u32,
 }
 
 const FORCE_BITS: u32 = mpca_force::Uniform as u32 | mpca_force::Field as u32 | mpca_force::Potential as u32 | mpca_force::Vortex as u32;
@@ -178,6 +182,7 @@ impl mpca_desc {
             lifetimes: u32::from(d.lifetimes),
             collisions: d.collisions as u32,
             contacts: u32::from(d.contacts),
+            energy_neutral: u32::from(d.energy_neutral),
         }
     }
 
@@ -235,6 +240,7 @@ impl mpca_desc {
             _ => return Err(mpca_status::BadEnum),
         };
         d.contacts = flag(self.contacts)?;
+        d.energy_neutral = flag(self.energy_neutral)?;
         d.emitter_capacity = self.emitter_capacity;
         d.lifetimes = flag(self.lifetimes)?;
         Ok(d)

@@ -19,7 +19,7 @@
 #include "check.h"
 
 /* The layout ffi/src/lib.rs asserts on the Rust side. */
-STATIC_ASSERT(sizeof(mpca_desc) == 144 && ALIGNOF(mpca_desc) == 8, "mpca_desc layout");
+STATIC_ASSERT(sizeof(mpca_desc) == 152 && ALIGNOF(mpca_desc) == 8, "mpca_desc layout");
 STATIC_ASSERT(sizeof(mpca_stats) == 144 && ALIGNOF(mpca_stats) == 8, "mpca_stats layout");
 STATIC_ASSERT(sizeof(mpca_particle) == 32 && ALIGNOF(mpca_particle) == 4, "mpca_particle layout");
 STATIC_ASSERT(sizeof(mpca_cell) == 36 && ALIGNOF(mpca_cell) == 4, "mpca_cell layout");
@@ -383,6 +383,7 @@ static void description_cases(void) {
         DESC_VALUES(base, method, MPCA_STATUS_BAD_ENUM, 3, UINT32_MAX);
         DESC_VALUES(base, collisions, MPCA_STATUS_BAD_ENUM, 2, UINT32_MAX);
         DESC_VALUES(base, contacts, MPCA_STATUS_BAD_ENUM, 2, UINT32_MAX);
+        DESC_VALUES(base, energy_neutral, MPCA_STATUS_BAD_ENUM, 2, UINT32_MAX);
         DESC_VALUES(base, mass_classes, MPCA_STATUS_CAPACITY_RANGE, 0, 257, UINT32_MAX);
 
         /* Every float field, the third gravity component in 2D included. */

@@ -51,6 +51,7 @@ fn description(dim: u32, faces: Faces, variant: usize) -> Description {
     desc.method = [Method::ExactFast, Method::Greedy, Method::Exhaustive][variant % 3];
     desc.collisions = [Collisions::Paper, Collisions::SpeedLimited][variant / 2 % 2];
     desc.contacts = variant % 4 < 2;
+    desc.energy_neutral = variant % 3 == 1;
     desc.seed = 0x5eed_0000 + variant as u64;
     desc
 }

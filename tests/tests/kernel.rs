@@ -36,7 +36,8 @@ fn gas<'a>(desc: &Description, density: f32, speed: f32, seed: u64, memory: &'a 
 /// Every plain setting: 2D and 3D; periodic, walled and open faces (whose
 /// half blocks take the general routine in both runs); no force and
 /// gravity; with and without an obstacle; both widths, both drift rules,
-/// all three methods, both collision rules, with and without contacts.
+/// all three methods, both collision rules, with and without contacts and
+/// energy-neutral rounding.
 fn settings() -> Vec<Description> {
     let mut out = vec![];
     for dim in [2u32, 3] {
@@ -50,6 +51,7 @@ fn settings() -> Vec<Description> {
                 d.restitution = [1.0, 0.6, 0.0][i];
                 d.collisions = [Collisions::Paper, Collisions::SpeedLimited][(variant + i) % 2];
                 d.contacts = (variant + i / 2) % 2 == 1;
+                d.energy_neutral = (variant + i) % 3 == 0;
                 if variant % 2 == 1 {
                     d.forces.uniform = true;
                     d.gravity = [0.004, -0.03, 0.01];
