@@ -238,6 +238,10 @@ enum mpca_status
    */
   MPCA_STATUS_OUT_OF_MEMORY = 132,
   /**
+   * A flow drag rate is negative (M5.1b).
+   */
+  MPCA_STATUS_BAD_DRAG = 140,
+  /**
    * An error this version of the C ABI does not know by name.
    */
   MPCA_STATUS_UNKNOWN = 199,
@@ -573,6 +577,20 @@ typedef struct mpca_desc {
    * unbiased rounding only.
    */
   uint32_t energy_neutral;
+  /**
+   * Flow drag rate per unit time (M5.1b), not negative; 0 is off. Each
+   * velocity relaxes towards the flow: v <- (v + dt rate u) / (1 + dt
+   * rate).
+   */
+  float drag_rate;
+  /**
+   * The uniform part of the flow `u`, |drag_wind| <= 1.
+   */
+  float drag_wind[3];
+  /**
+   * 1: the vortex (`vortex_*`) read as a velocity field adds to the flow.
+   */
+  uint32_t drag_vortex;
 } mpca_desc;
 
 /**

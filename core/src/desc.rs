@@ -54,6 +54,23 @@ pub enum Collisions {
     SpeedLimited = 1,
 }
 
+/// M5.1b flow drag (beyond the paper): after the forces of M5.1, each
+/// velocity relaxes towards the flow velocity `u` at its cell at `rate` per
+/// unit time, `v <- (v + dt rate u) / (1 + dt rate)` (backward Euler: stable
+/// for any `dt rate`, never past `u`). The flow is `wind` plus, if `vortex`,
+/// the Rankine vortex of the description read as a velocity field
+/// (`G r / (2 pi R^2)` inside the core, `G / (2 pi r)` outside, tangential).
+/// A rate of 0 is off. Needs the `fields` feature.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Drag {
+    /// The relaxation rate per unit time, finite and not negative.
+    pub rate: f32,
+    /// A uniform flow velocity, `|wind| <= 1`.
+    pub wind: [f32; 3],
+    /// Add the vortex's velocity field to the flow.
+    pub vortex: bool,
+}
+
 /// The force terms a world sums in M5.1. Uniform acceleration needs no
 /// storage; the other three need the `fields` feature.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -132,6 +149,8 @@ pub struct Description {
     pub quantization: Quantization,
     /// The move probability rule.
     pub drift: Drift,
+    /// Flow drag towards a wind and the vortex (M5.1b); rate 0 is off.
+    pub drag: Drag,
     /// The move assignment method.
     pub method: Method,
     /// How collisions pick their direction.
@@ -178,6 +197,7 @@ impl Description {
             seed: 0,
             quantization: Quantization::Bits8,
             drift: Drift::Calibrated,
+            drag: Drag { rate: 0.0, wind: [0.0; 3], vortex: false },
             method: Method::ExactFast,
             collisions: Collisions::Paper,
             contacts: false,

@@ -26,6 +26,8 @@ pub enum Error {
     NegativeDt,
     /// The vortex core radius is not greater than zero.
     BadVortex,
+    /// A flow drag rate is negative (M5.1b).
+    BadDrag,
     /// A restitution lies outside `[0, 1]` (M1).
     RestitutionRange,
     /// A mass is not strictly positive (M1).
@@ -91,6 +93,7 @@ impl Error {
             Error::NotFinite => "a floating-point input is NaN or infinite",
             Error::NegativeDt => "the time step must not be negative",
             Error::BadVortex => "the vortex core radius must be greater than zero",
+            Error::BadDrag => "the flow drag rate must not be negative",
             Error::RestitutionRange => "a restitution lies outside [0, 1]",
             Error::MassRange => "a mass must be greater than zero",
             Error::SpeedRange => "a speed must not exceed 1 cell per step",

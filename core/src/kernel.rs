@@ -39,8 +39,8 @@
 use crate::assign::{assign_moves, optimal_moves_2d, pick_move, Method, MoveProblem, PLACE_2D};
 use crate::cells::Cells;
 use crate::collision::{block_pairs, collide_limited, collide_pair, energy_neutral, pair_holds_two, random_unit, shares};
-use crate::desc::{Collisions, Description};
-use crate::force::ForceTerms;
+use crate::desc::{Collisions, Description, Vortex};
+use crate::force::{vortex_force, ForceTerms};
 use crate::obstacle::{reflect, surface_at, Surface};
 use crate::partition::{cells_at, resolve, BlockRow, BlockSink, Beyond, Index, Partition};
 use crate::quant::Quant;
@@ -64,6 +64,9 @@ pub(crate) struct Shared<'a> {
     pub push: Option<[f32; 3]>,
     /// `dt * SCALE`: turns an acceleration into quanta per step.
     pub dt_q: f32,
+    /// M5.1b flow drag, where its rate is not 0: the uniform wind in
+    /// quanta, the vortex read as a velocity, and `dt * rate`.
+    pub drag: Option<([f32; 3], Option<Vortex>, f32)>,
     /// The 8-bit move table of the drift rule (M5.3).
     pub moves: &'static [u16; 256],
     /// One mass, no lifetimes: blocks away from the faces and without an
@@ -631,8 +634,27 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
             }
         }
 
-        // M5.2 collision, then M1 for what the force and the collision
-        // changed.
+        // M5.1b flow drag: v <- (v + a u) / (1 + a), u the flow at the cell.
+        if let Some((wind, vortex, a)) = sh.drag {
+            for c in cells_of(occ) {
+                let mut u = wind;
+                if let Some(v) = vortex {
+                    let pos = sh.part.cell_coords(row, [xs[c & 1], 0, 0], c);
+                    let t = vortex_force(&v, [pos[0] as f32 + 0.5, pos[1] as f32 + 0.5]);
+                    u[0] += t[0] * Q::SCALE;
+                    u[1] += t[1] * Q::SCALE;
+                }
+                let mut x = b.velocity(c);
+                for k in 0..D {
+                    x[k] = (x[k] + a * u[k]) / (1.0 + a);
+                }
+                clamp_counted(&mut x, Q::SCALE, mass[c], &mut self.counters);
+                b.set(c, x);
+            }
+        }
+
+        // M5.2 collision, then M1 for what the force, the drag and the
+        // collision changed.
         self.collide(&mut b, &mut rng, |c| mass[c], !desc.per_particle_mass);
         b.round::<Q>(&mut rng);
 

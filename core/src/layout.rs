@@ -136,12 +136,25 @@ impl Layout {
         if d.forces.vortex && d.vortex.core_radius <= 0.0 {
             return Err(Error::BadVortex);
         }
+        // M5.1b: a rate of 0 is off, and the wind is a velocity.
+        finite(&[d.drag.rate])?;
+        finite(&d.drag.wind)?;
+        if d.drag.rate < 0.0 {
+            return Err(Error::BadDrag);
+        }
+        let w = &d.drag.wind[..dim];
+        if w.iter().map(|c| c * c).sum::<f32>() > 1.0 {
+            return Err(Error::SpeedRange);
+        }
+        if d.drag.vortex && d.drag.rate > 0.0 && d.vortex.core_radius <= 0.0 {
+            return Err(Error::BadVortex);
+        }
         if d.quantization == Quantization::Bits16 && !cfg!(feature = "q16") {
             return Err(Error::Q16Disabled);
         }
         if (d.per_particle_mass && !cfg!(feature = "mass"))
             || (d.obstacles && !cfg!(feature = "obstacles"))
-            || (d.forces.any_field() && !cfg!(feature = "fields"))
+            || ((d.forces.any_field() || d.drag.rate > 0.0) && !cfg!(feature = "fields"))
         {
             return Err(Error::FeatureDisabled);
         }

@@ -65,7 +65,7 @@ mod vector;
 mod world;
 
 pub use assign::Method;
-pub use desc::{Boundary, Collisions, Description, Drift, Forces, Quantization, Vortex};
+pub use desc::{Boundary, Collisions, Description, Drag, Drift, Forces, Quantization, Vortex};
 pub use emitter::Emitter;
 pub use error::Error;
 pub use obstacle::{Shape, Surface};

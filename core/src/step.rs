@@ -181,6 +181,10 @@ impl World {
             push: (push != [0.0; 3]).then_some(push),
             terms,
             dt_q,
+            drag: (desc.drag.rate > 0.0).then(|| {
+                let wind = desc.drag.wind.map(|w| w * Q::SCALE);
+                (wind, desc.drag.vortex.then_some(desc.vortex), desc.dt * desc.drag.rate)
+            }),
             moves: crate::quant::move_table_8(desc.drift),
             plain: route.lean && !desc.per_particle_mass && !desc.lifetimes,
         };
@@ -205,7 +209,7 @@ impl World {
 /// per particle; a uniform force alone is one precomputed change.
 fn with_force<Q: Quant, const D: usize, const CELLS: usize>(w: &mut World, route: Route, split: Split<'_>) {
     #[cfg(feature = "fields")]
-    if w.head.desc.forces.any_field() {
+    if w.head.desc.forces.any_field() || w.head.desc.drag.rate > 0.0 {
         return run::<Q, D, CELLS, true>(w, route, split);
     }
     run::<Q, D, CELLS, false>(w, route, split)

@@ -1,6 +1,6 @@
 //! `mpca_desc`: the scene description (M9), as C sees it.
 
-use mpca_core::{Boundary, Collisions, Description, Drift, Forces, Method, Quantization, Vortex};
+use mpca_core::{Boundary, Collisions, Description, Drag, Drift, Forces, Method, Quantization, Vortex};
 
 use crate::{check_size, flag, guard, mpca_status, read, write};
 
@@ -124,6 +124,14 @@ pub struct mpca_desc {
     /// adds on average (M1b), so an elastic world keeps its energy. 0:
     /// unbiased rounding only.
     pub energy_neutral: u32,
+    /// Flow drag rate per unit time (M5.1b), not negative; 0 is off. Each
+    /// velocity relaxes towards the flow: v <- (v + dt rate u) / (1 + dt
+    /// rate).
+    pub drag_rate: f32,
+    /// The uniform part of the flow `u`, |drag_wind| <= 1.
+    pub drag_wind: [f32; 3],
+    /// 1: the vortex (`vortex_*`) read as a velocity field adds to the flow.
+    pub drag_vortex: u32,
 }
 
 const FORCE_BITS: u32 = mpca_force::Uniform as u32 | mpca_force::Field as u32 | mpca_force::Potential as u32 | mpca_force::Vortex as u32;
@@ -183,6 +191,9 @@ impl mpca_desc {
             collisions: d.collisions as u32,
             contacts: u32::from(d.contacts),
             energy_neutral: u32::from(d.energy_neutral),
+            drag_rate: d.drag.rate,
+            drag_wind: d.drag.wind,
+            drag_vortex: u32::from(d.drag.vortex),
         }
     }
 
@@ -241,6 +252,7 @@ impl mpca_desc {
         };
         d.contacts = flag(self.contacts)?;
         d.energy_neutral = flag(self.energy_neutral)?;
+        d.drag = Drag { rate: self.drag_rate, wind: self.drag_wind, vortex: flag(self.drag_vortex)? };
         d.emitter_capacity = self.emitter_capacity;
         d.lifetimes = flag(self.lifetimes)?;
         Ok(d)

@@ -105,6 +105,8 @@ pub enum mpca_status {
     NotOwned = 131,
     /// The allocator refused the memory.
     OutOfMemory = 132,
+    /// A flow drag rate is negative (M5.1b).
+    BadDrag = 140,
     /// An error this version of the C ABI does not know by name.
     Unknown = 199,
 }
@@ -122,6 +124,7 @@ impl From<Error> for mpca_status {
             Error::NotFinite => S::NotFinite,
             Error::NegativeDt => S::NegativeDt,
             Error::BadVortex => S::BadVortex,
+            Error::BadDrag => S::BadDrag,
             Error::RestitutionRange => S::RestitutionRange,
             Error::MassRange => S::MassRange,
             Error::SpeedRange => S::SpeedRange,
@@ -177,6 +180,7 @@ impl mpca_status {
             S::NotFinite => c"a floating-point input is NaN or infinite",
             S::NegativeDt => c"the time step must not be negative",
             S::BadVortex => c"the vortex core radius must be greater than zero",
+            S::BadDrag => c"the flow drag rate must not be negative",
             S::RestitutionRange => c"a restitution lies outside [0, 1]",
             S::MassRange => c"a mass must be greater than zero",
             S::SpeedRange => c"a speed must not exceed 1 cell per step",
@@ -218,11 +222,11 @@ pub extern "C" fn mpca_status_message(status: u32) -> *const c_char {
 /// The status numbered `n`, if there is one.
 pub(crate) fn status_from_u32(n: u32) -> Option<mpca_status> {
     use mpca_status as S;
-    const ALL: [mpca_status; 45] = [
+    const ALL: [mpca_status; 46] = [
         S::Ok, S::NullPointer, S::BadHandle, S::Panic, S::BadStructSize, S::BadEnum, S::OutputTooSmall, S::NotASurface,
         S::Busy, S::StaleTask, S::TaskIndex, S::TaskDone,
         S::BadDimension, S::Dim3Disabled, S::SizeZero, S::SizeOdd, S::TooLarge, S::PeriodicMismatch,
-        S::NotFinite, S::NegativeDt, S::BadVortex, S::RestitutionRange, S::MassRange, S::SpeedRange,
+        S::NotFinite, S::NegativeDt, S::BadVortex, S::BadDrag, S::RestitutionRange, S::MassRange, S::SpeedRange,
         S::Q16Disabled, S::FeatureDisabled, S::NotEnabled, S::CapacityRange, S::BufferTooSmall,
         S::OutOfBounds, S::CellOccupied, S::CellObstacle, S::NoParticle, S::MassTableFull,
         S::SurfaceTableFull, S::UndefinedNormal, S::EmitterTableFull, S::BadEmitter, S::LifetimeRange,

@@ -19,7 +19,7 @@
 #include "check.h"
 
 /* The layout ffi/src/lib.rs asserts on the Rust side. */
-STATIC_ASSERT(sizeof(mpca_desc) == 152 && ALIGNOF(mpca_desc) == 8, "mpca_desc layout");
+STATIC_ASSERT(sizeof(mpca_desc) == 168 && ALIGNOF(mpca_desc) == 8, "mpca_desc layout");
 STATIC_ASSERT(sizeof(mpca_stats) == 144 && ALIGNOF(mpca_stats) == 8, "mpca_stats layout");
 STATIC_ASSERT(sizeof(mpca_particle) == 32 && ALIGNOF(mpca_particle) == 4, "mpca_particle layout");
 STATIC_ASSERT(sizeof(mpca_cell) == 36 && ALIGNOF(mpca_cell) == 4, "mpca_cell layout");
@@ -384,6 +384,7 @@ static void description_cases(void) {
         DESC_VALUES(base, collisions, MPCA_STATUS_BAD_ENUM, 2, UINT32_MAX);
         DESC_VALUES(base, contacts, MPCA_STATUS_BAD_ENUM, 2, UINT32_MAX);
         DESC_VALUES(base, energy_neutral, MPCA_STATUS_BAD_ENUM, 2, UINT32_MAX);
+        DESC_VALUES(base, drag_vortex, MPCA_STATUS_BAD_ENUM, 2, UINT32_MAX);
         DESC_VALUES(base, mass_classes, MPCA_STATUS_CAPACITY_RANGE, 0, 257, UINT32_MAX);
 
         /* Every float field, the third gravity component in 2D included. */
@@ -406,6 +407,10 @@ static void description_cases(void) {
         DESC_FLOATS(base, wall_restitution, MPCA_STATUS_RESTITUTION_RANGE, 1.5f, -0.1f);
         DESC_FLOATS(base, dt, MPCA_STATUS_NEGATIVE_DT, -1.0f, -1e-30f);
         DESC_FLOATS(base, vortex_core_radius, MPCA_STATUS_BAD_VORTEX, 0.0f, -2.0f);
+        DESC_FLOATS(base, drag_rate, MPCA_STATUS_NOT_FINITE, NAN, INFINITY, -INFINITY);
+        DESC_FLOATS(base, drag_rate, MPCA_STATUS_BAD_DRAG, -1.0f, -1e-30f);
+        DESC_FLOATS(base, drag_wind[0], MPCA_STATUS_NOT_FINITE, NAN, INFINITY);
+        DESC_FLOATS(base, drag_wind[1], MPCA_STATUS_SPEED_RANGE, 1.0001f, -2.0f);
     }
 
     /* 2^16 x 2^16 x 2 cells: more than a 32-bit cell index holds. */
@@ -1159,6 +1164,7 @@ static const struct {
     STATUS(MPCA_STATUS_NOT_FINITE),
     STATUS(MPCA_STATUS_NEGATIVE_DT),
     STATUS(MPCA_STATUS_BAD_VORTEX),
+    STATUS(MPCA_STATUS_BAD_DRAG),
     STATUS(MPCA_STATUS_RESTITUTION_RANGE),
     STATUS(MPCA_STATUS_MASS_RANGE),
     STATUS(MPCA_STATUS_SPEED_RANGE),

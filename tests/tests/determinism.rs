@@ -5,7 +5,7 @@
 
 mod common;
 
-use mpca::{Boundary, Collisions, Description, Drift, Emitter, Method, Quantization, Shape, Stats, Vortex, World};
+use mpca::{Boundary, Collisions, Description, Drag, Drift, Emitter, Method, Quantization, Shape, Stats, Vortex, World};
 
 /// The boundary kinds a configuration can have.
 #[derive(Clone, Copy, Debug)]
@@ -52,6 +52,9 @@ fn description(dim: u32, faces: Faces, variant: usize) -> Description {
     desc.collisions = [Collisions::Paper, Collisions::SpeedLimited][variant / 2 % 2];
     desc.contacts = variant % 4 < 2;
     desc.energy_neutral = variant % 3 == 1;
+    if variant % 2 == 0 {
+        desc.drag = Drag { rate: 0.2, wind: [0.05, 0.1, -0.05], vortex: dim == 2 };
+    }
     desc.seed = 0x5eed_0000 + variant as u64;
     desc
 }
