@@ -80,6 +80,18 @@ cpu_flags() {
 opt_level() { case $1 in all) echo z ;; *) echo "$1" ;; esac; }
 features() { case $1 in all) echo dim3,obstacles,fields,mass,q16 ;; *) echo fields ;; esac; }
 
+# The plugin's per-block counts summed per function: symbols and blocks
+# sorted together by address, each block going to the symbol before it.
+profile() {
+    {
+        arm-none-eabi-nm -n --defined-only -C "$1" | awk '$2 ~ /^[tTwW]$/ {a = $1; $1 = $2 = ""; print a, "S", substr($0, 3)}'
+        awk '{print $1, "B", $2}' "$2"
+    } | LC_ALL=C sort -k1,1 -k2,2r |
+        awk '$2 == "S" {name = $0; sub(/^[^ ]+ S /, "", name); next} {sum[name] += $3}
+             END {for (f in sum) print sum[f], f}' |
+        sort -rn | awk -v total="$3" 'NR <= 10 {n = $1; $1 = ""; printf "  %5.1f%% %s\n", 100 * n / total, substr($0, 2)}'
+}
+
 section() { awk -v s="$2" '$1 == s {print $2; f=1} END {if (!f) print 0}' "$1"; }
 
 variants=(z)
@@ -109,11 +121,11 @@ for variant in "${variants[@]}"; do
 
         begin=$(arm-none-eabi-nm "$dir/smoke64.elf" | awk '$3 == "mark_begin" {print "0x" $1}')
         end=$(arm-none-eabi-nm "$dir/smoke64.elf" | awk '$3 == "mark_end" {print "0x" $1}')
-        rm -f "$dir/insn.txt"
+        rm -f "$dir/insn.txt" "$dir/profile.txt"
         qemu=(qemu-system-arm -M "$(board $core)" -nographic -semihosting-config enable=on,target=native
             -kernel "$dir/smoke64.elf")
         rc=0
-        timeout 60 "${qemu[@]}" -plugin "$plugin,begin=$begin,end=$end,out=$dir/insn.txt" \
+        timeout 60 "${qemu[@]}" -plugin "$plugin,begin=$begin,end=$end,out=$dir/insn.txt,profile=$dir/profile.txt" \
             </dev/null >"$dir/log" 2>&1 || rc=$?
         if grep -q "Could not load plugin" "$dir/log"; then
             # A QEMU without plugins, or of another plugin API: no count.
@@ -145,6 +157,10 @@ for variant in "${variants[@]}"; do
             per_step=n/a per_block=n/a
         fi
         rows+=("$variant $core $text $rodata $data $bss $stack $ram $per_step $per_block $verdict")
+        if [ "$table" = 1 ] && [ -s "$dir/profile.txt" ]; then
+            echo "firmware: $variant/$core, the functions executing the most instructions in the $steps steps:"
+            profile "$dir/smoke64.elf" "$dir/profile.txt" "$insn"
+        fi
 
         if [ "$variant" = z ]; then
             over=()
