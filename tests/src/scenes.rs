@@ -136,6 +136,32 @@ fn fill_smoke(w: &mut World) -> Result<(), Error> {
     Ok(())
 }
 
+/// The firmware example's scene (`c_examples/firmware/smoke64.c`, issue 12):
+/// 4.3 smoke at 64 x 64, scaled as `c_examples/smoke.c --size 64` scales it
+/// (the vortex's centre, core and circulation by half, the emitter to
+/// cells 30..34 of the bottom row); the same seed, rate and velocity.
+pub fn smoke_64() -> Scene {
+    let mut scene = smoke();
+    scene.name = "smoke-64";
+    scene.desc.size = [64, 64, 1];
+    scene.desc.vortex = Vortex { centre: [32.0, 36.0], core_radius: 5.0, circulation: 1.0 };
+    scene.setup = fill_smoke_64;
+    scene
+}
+
+fn fill_smoke_64(w: &mut World) -> Result<(), Error> {
+    w.add_emitter(Emitter {
+        min: [30, 0, 0],
+        max: [34, 1, 1],
+        rate: 1.0,
+        velocity: [0.0, 0.6, 0.0],
+        spread: 0.2,
+        mass: 1.0,
+        lifetime: 0,
+    })?;
+    Ok(())
+}
+
 /// 4.4 water: 3D 64^3, emitted at the top, gravity, a sphere obstacle in the
 /// middle, e = 1, 130 steps. y is up; walls all round. The emitter (the paper
 /// gives no rate) pours 16 particles a step from an 8 x 8 patch.

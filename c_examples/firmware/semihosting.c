@@ -1,0 +1,58 @@
+#include "semihosting.h"
+
+enum {
+    SYS_WRITE0 = 0x04,
+    SYS_EXIT = 0x18,
+    /* Reasons for SYS_EXIT; on 32-bit Arm r1 holds the reason itself. */
+    ADP_STOPPED_RUN_TIME_ERROR = 0x20023,
+    ADP_STOPPED_APPLICATION_EXIT = 0x20026,
+};
+
+static uintptr_t semihost(uintptr_t request, const void *argument) {
+    register uintptr_t r0 __asm__("r0") = request;
+    register const void *r1 __asm__("r1") = argument;
+    /* "memory": the debugger reads what r1 points at. */
+    __asm__ volatile("bkpt 0xab" : "+r"(r0) : "r"(r1) : "memory");
+    return r0;
+}
+
+void sh_write0(const char *text) {
+    semihost(SYS_WRITE0, text);
+}
+
+_Noreturn void sh_exit(int status) {
+    semihost(SYS_EXIT, (const void *)(uintptr_t)(status == 0 ? ADP_STOPPED_APPLICATION_EXIT : ADP_STOPPED_RUN_TIME_ERROR));
+    for (;;) {
+        /* Only reached without a debugger: nothing left to do. */
+    }
+}
+
+static void put(sh_line *line, char c) {
+    /* One byte stays free for the NUL; a longer line is cut, not overrun. */
+    if (line->len + 1 < sizeof line->text) line->text[line->len++] = c;
+}
+
+void sh_str(sh_line *line, const char *text) {
+    while (*text) put(line, *text++);
+}
+
+void sh_dec(sh_line *line, uint32_t value) {
+    char digits[10];
+    int n = 0;
+    do {
+        digits[n++] = (char)('0' + value % 10);
+        value /= 10;
+    } while (value != 0);
+    while (n > 0) put(line, digits[--n]);
+}
+
+void sh_hex64(sh_line *line, uint64_t value) {
+    for (int shift = 60; shift >= 0; shift -= 4) put(line, "0123456789abcdef"[(value >> shift) & 0xf]);
+}
+
+void sh_flush(sh_line *line) {
+    put(line, '\n');
+    line->text[line->len] = '\0';
+    sh_write0(line->text);
+    line->len = 0;
+}
