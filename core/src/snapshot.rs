@@ -754,8 +754,12 @@ impl World {
     /// restitutions, method, faces...) is taken from the image. A world built
     /// from [`image_description`] always fits.
     ///
-    /// The whole image is checked before anything is written; a refused
-    /// image leaves the world as it was (see `read` for the errors).
+    /// The whole image is checked before anything is written, and a refused
+    /// image leaves the world as it was: `NotAnImage` (wrong magic),
+    /// `ImageLength` (cut short, or bytes after its end), `ImageVersion`,
+    /// `ImageChecksum` (damaged), `ImageInvalid` (well framed, but not a
+    /// world this library could have written), or the error of a part this
+    /// build left out (`Dim3Disabled`, `Q16Disabled`, `FeatureDisabled`).
     pub fn load(&mut self, image: &[u8]) -> Result<(), Error> {
         let img = read(image)?;
         if img.layout != self.head.layout {

@@ -168,9 +168,11 @@ fn paper_scenes_load_bit_identical_and_step_on_alike() {
         w.step(scene.steps / 2);
         let cells: u64 = scene.desc.size.iter().take(scene.desc.dim as usize).map(|&s| u64::from(s)).product();
         let particles = w.particle_count();
+        let crc = u32_at(&image(w), w.snapshot_bytes() - 4);
         let bytes = round_trip(scene.name, w, 20);
+        // The CRC names the image: equal on every target (M8, M12).
         println!(
-            "{}: {particles} particles after {} steps, image {bytes} bytes, {:.3} bytes per cell (world {:.3})",
+            "{}: {particles} particles after {} steps, image {bytes} bytes (crc {crc:08x}), {:.3} bytes per cell (world {:.3})",
             scene.name,
             scene.steps / 2,
             bytes as f64 / cells as f64,
@@ -185,8 +187,9 @@ fn every_part_worlds_load_bit_identical_and_step_on_alike() {
     for method in [Method::Exhaustive, Method::ExactFast, Method::Greedy] {
         let w = scenes::every_part(&mut memory, method);
         w.step(30);
+        let crc = u32_at(&image(w), w.snapshot_bytes() - 4);
         let bytes = round_trip(&format!("every-part-{method:?}"), w, 30);
-        println!("every-part-{method:?}: image {bytes} bytes, {:.3} bytes per cell", bytes as f64 / 4096.0);
+        println!("every-part-{method:?}: image {bytes} bytes (crc {crc:08x}), {:.3} bytes per cell", bytes as f64 / 4096.0);
     }
     let mut memory = Vec::new();
     let w = small_world(&mut memory, 25);
@@ -660,4 +663,17 @@ fn region_counters_agree_with_a_count_by_hand_on_stepped_worlds() {
         boxes += 1;
     }
     println!("{boxes} boxes against the count by hand");
+}
+
+/// The bytes of format version 1 for a world that has not stepped (so only
+/// the setup, not the step, decides them): a change here is a change of the
+/// format, which must come with a new IMAGE_VERSION. Equal on x86-64 and
+/// 32-bit Arm.
+#[test]
+fn the_format_of_version_1_is_pinned() {
+    let mut memory = Vec::new();
+    let img = image(small_world(&mut memory, 0));
+    let crc = u32_at(&img, img.len() - 4);
+    println!("small world at step 0: image {} bytes, crc {crc:08x}", img.len());
+    assert_eq!((img.len(), crc), (4302, 0x28af_b70b));
 }
