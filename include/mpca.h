@@ -107,6 +107,11 @@ enum mpca_status
    */
   MPCA_STATUS_TASK_DONE = 11,
   /**
+   * Two memory ranges of the call overlap: an image and the memory of
+   * the world it is saved from, loaded into or built in.
+   */
+  MPCA_STATUS_OVERLAP = 12,
+  /**
    * The dimension is neither 2 nor 3.
    */
   MPCA_STATUS_BAD_DIMENSION = 100,
@@ -237,6 +242,33 @@ enum mpca_status
    * The allocator refused the memory.
    */
   MPCA_STATUS_OUT_OF_MEMORY = 132,
+  /**
+   * The bytes do not start with the magic of a world image.
+   */
+  MPCA_STATUS_NOT_AN_IMAGE = 133,
+  /**
+   * The image is of a format version this library does not read.
+   */
+  MPCA_STATUS_IMAGE_VERSION = 134,
+  /**
+   * The image is shorter or longer than its header says: cut short, or
+   * the length passed runs past its end.
+   */
+  MPCA_STATUS_IMAGE_LENGTH = 135,
+  /**
+   * The image's checksum does not match its bytes: it was damaged.
+   */
+  MPCA_STATUS_IMAGE_CHECKSUM = 136,
+  /**
+   * The image is well framed and its checksum matches, but it does not
+   * hold a consistent world.
+   */
+  MPCA_STATUS_IMAGE_INVALID = 137,
+  /**
+   * The image holds a world of another size or plan of memory than the
+   * world it is loaded into.
+   */
+  MPCA_STATUS_IMAGE_MISMATCH = 138,
   /**
    * A flow drag rate is negative (M5.1b).
    */
@@ -756,6 +788,33 @@ typedef struct mpca_stats {
   double bytes_per_cell;
 } mpca_stats;
 
+/**
+ * The particles inside a box of cells and their motion, from
+ * mpca_world_region_stats. Set `struct_size` before the call.
+ */
+typedef struct mpca_region_stats {
+  /**
+   * `sizeof(mpca_region_stats)`, set by the caller.
+   */
+  uint32_t struct_size;
+  /**
+   * Reserved, 0.
+   */
+  uint32_t reserved;
+  /**
+   * Particles in the box.
+   */
+  uint64_t particles;
+  /**
+   * Their momentum, sum m v.
+   */
+  double momentum[3];
+  /**
+   * Their kinetic energy, sum m |v|^2 / 2.
+   */
+  double kinetic_energy;
+} mpca_region_stats;
+
 #ifdef __cplusplus
 extern "C" {
 #endif // __cplusplus
@@ -1038,6 +1097,70 @@ mpca_status mpca_world_density_u8(const struct mpca_world *world,
                                   size_t len);
 
 /**
+ * Writes to `out_bytes` the length of the image mpca_world_save would
+ * write now. It changes as particles, surface cells and emitters come and
+ * go, never beyond the size of the world's memory plus 252 bytes.
+ */
+mpca_status mpca_world_snapshot_bytes(const struct mpca_world *world, size_t *out_bytes);
+
+/**
+ * Writes the world's image (docs/model.md, M12) to `buf`, which has room
+ * for `len` bytes, and its length to `out_written`. As with snprintf, `buf`
+ * NULL with `len` 0 only asks for the length: `out_written` gets it and
+ * the call succeeds. A `len` below the image's length writes nothing but
+ * `out_written` and returns `MPCA_STATUS_OUTPUT_TOO_SMALL`. `buf` may not
+ * overlap the world's memory (`MPCA_STATUS_OVERLAP`).
+ */
+mpca_status mpca_world_save(const struct mpca_world *world,
+                            void *buf,
+                            size_t len,
+                            size_t *out_written);
+
+/**
+ * Makes the world the one the image of `len` bytes at `image` holds: its
+ * description, step, counters, particles, obstacles, force planes, masses
+ * and emitters, so that it hashes equal to the saved world and steps on as
+ * that world would have. The world must have the image's plan of memory
+ * (sizes, velocity width, parts and capacities of its description; what
+ * does not change the plan, such as the seed or the forces' values, comes
+ * from the image): else `MPCA_STATUS_IMAGE_MISMATCH`. A world built from
+ * mpca_desc_from_image always fits.
+ *
+ * The whole image is checked before the world is written, and a refused
+ * image changes nothing: `MPCA_STATUS_NOT_AN_IMAGE` (wrong magic),
+ * `MPCA_STATUS_IMAGE_LENGTH` (cut short, or `len` beyond its end),
+ * `MPCA_STATUS_IMAGE_VERSION`, `MPCA_STATUS_IMAGE_CHECKSUM` (damaged),
+ * `MPCA_STATUS_IMAGE_INVALID` (well framed but not a consistent world),
+ * or the status of a part this library was built without. The image may
+ * not overlap the world's memory (`MPCA_STATUS_OVERLAP`).
+ */
+mpca_status mpca_world_load(struct mpca_world *world, const void *image, size_t len);
+
+/**
+ * Writes to `out` the description of the world the image of `len` bytes
+ * at `image` holds, after checking the whole image as mpca_world_load
+ * does. mpca_world_bytes of it sizes the memory for
+ * mpca_world_init_from_image; mpca_world_create of it makes a world that
+ * mpca_world_load accepts the image into.
+ */
+mpca_status mpca_desc_from_image(const void *image, size_t len, struct mpca_desc *out);
+
+/**
+ * Builds the world the image of `image_len` bytes at `image` holds in
+ * `memory` (`len` bytes, any alignment, at least mpca_world_bytes of
+ * mpca_desc_from_image), as mpca_world_init builds an empty one, and
+ * writes its handle to `out_world`. The image is checked in full first: a
+ * refused image (see mpca_world_load) or too small a memory leaves
+ * `memory` unwritten, and a live world in it alive. The image may not
+ * overlap `memory` (`MPCA_STATUS_OVERLAP`).
+ */
+mpca_status mpca_world_init_from_image(const void *image,
+                                       size_t image_len,
+                                       void *memory,
+                                       size_t len,
+                                       struct mpca_world **out_world);
+
+/**
  * A static, NUL-terminated English message for `status`; never NULL, never
  * to be freed. Values that are not statuses get a message saying so.
  */
@@ -1099,6 +1222,21 @@ mpca_status mpca_world_stats(const struct mpca_world *world, struct mpca_stats *
  * lifetime: equal worlds hash equal on every target and through every API.
  */
 mpca_status mpca_world_hash(const struct mpca_world *world, uint64_t *out_hash);
+
+/**
+ * Fills `out` (whose `struct_size` the caller set) with the particles in
+ * the box of cells `min <= pos < max` (3 values each, per axis; the third
+ * is ignored in 2D) and their momentum and kinetic energy, summed as
+ * mpca_world_stats sums them: a box covering the world gives its figures
+ * exactly. For effects that trigger on what a region holds. An empty or
+ * reversed box (`min >= max` on an axis) is refused with
+ * `MPCA_STATUS_BAD_SHAPE`, one reaching beyond the world with
+ * `MPCA_STATUS_OUT_OF_BOUNDS`.
+ */
+mpca_status mpca_world_region_stats(const struct mpca_world *world,
+                                    const uint32_t *min,
+                                    const uint32_t *max,
+                                    struct mpca_region_stats *out);
 
 #ifdef __cplusplus
 }  // extern "C"

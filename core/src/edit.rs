@@ -17,7 +17,7 @@ use crate::Error;
 /// which moves a component by half a quantum at most. The point of the box
 /// `|x_k - q_k| <= 1` nearest the origin has `|x_k| = max(|q_k| - 1, 0)`; in
 /// integers, so the test is exact.
-fn storable(q: [i32; 3], scale: i32) -> bool {
+pub(crate) fn storable(q: [i32; 3], scale: i32) -> bool {
     let nearest: i64 = q
         .iter()
         .map(|&c| {

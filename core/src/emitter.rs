@@ -47,34 +47,42 @@ pub(crate) struct Slot {
 // SAFETY: u32 and f32 fields only, no padding, every bit pattern valid.
 unsafe impl Plain for Slot {}
 
+/// `e` as a world of `dim` dimensions, `n` cells per axis and, if
+/// `lifetimes`, an age plane stores it (2D drops the third axis), or why
+/// such a world refuses it. Shared by [`World::add_emitter`] and the
+/// snapshot loader (M12), which holds a stored emitter to the same rules.
+pub(crate) fn checked(e: Emitter, dim: usize, n: [usize; 3], lifetimes: bool) -> Result<Emitter, Error> {
+    // Every float is checked as given, before 2D drops the third axis.
+    finite(&[e.rate, e.velocity[0], e.velocity[1], e.velocity[2], e.spread])?;
+    let mut e = e;
+    if dim == 2 {
+        e.min[2] = 0;
+        e.max[2] = 1;
+        e.velocity[2] = 0.0;
+    }
+    if e.rate < 0.0 || e.spread < 0.0 || (0..3).any(|k| e.min[k] >= e.max[k] || e.max[k] as usize > n[k]) {
+        return Err(Error::BadEmitter);
+    }
+    // In f64: an f32 sum rounds 0.5 + 0.50000006 down to 1. The squares
+    // are exact in f64 and the rest errs by about 1e-16, far below the
+    // spacing of f32 values at 1 (6e-8 below, 1.2e-7 above).
+    let speed = libm::sqrt(e.velocity.iter().map(|&c| f64::from(c) * f64::from(c)).sum::<f64>());
+    if speed + f64::from(e.spread) > 1.0 {
+        return Err(Error::SpeedRange);
+    }
+    if e.lifetime > u32::from(u16::MAX) {
+        return Err(Error::LifetimeRange);
+    }
+    if e.lifetime > 0 && !lifetimes {
+        return Err(Error::NotEnabled);
+    }
+    Ok(e)
+}
+
 impl World {
     /// Adds an emitter and returns its index.
     pub fn add_emitter(&mut self, e: Emitter) -> Result<usize, Error> {
-        // Every float is checked as given, before 2D drops the third axis.
-        finite(&[e.rate, e.velocity[0], e.velocity[1], e.velocity[2], e.spread])?;
-        let mut e = e;
-        if self.dim() == 2 {
-            e.min[2] = 0;
-            e.max[2] = 1;
-            e.velocity[2] = 0.0;
-        }
-        let n = self.layout().n;
-        if e.rate < 0.0 || e.spread < 0.0 || (0..3).any(|k| e.min[k] >= e.max[k] || e.max[k] as usize > n[k]) {
-            return Err(Error::BadEmitter);
-        }
-        // In f64: an f32 sum rounds 0.5 + 0.50000006 down to 1. The squares
-        // are exact in f64 and the rest errs by about 1e-16, far below the
-        // spacing of f32 values at 1 (6e-8 below, 1.2e-7 above).
-        let speed = libm::sqrt(e.velocity.iter().map(|&c| f64::from(c) * f64::from(c)).sum::<f64>());
-        if speed + f64::from(e.spread) > 1.0 {
-            return Err(Error::SpeedRange);
-        }
-        if e.lifetime > u32::from(u16::MAX) {
-            return Err(Error::LifetimeRange);
-        }
-        if e.lifetime > 0 && !self.head.desc.lifetimes {
-            return Err(Error::NotEnabled);
-        }
+        let e = checked(e, self.dim(), self.layout().n, self.head.desc.lifetimes)?;
         let used = self.head.emitters as usize;
         if used >= self.layout().emitters.len / core::mem::size_of::<Slot>() {
             return Err(Error::EmitterTableFull);

@@ -78,6 +78,25 @@ pub enum Error {
     NotOwned,
     /// The allocator refused the memory.
     OutOfMemory,
+    /// The output buffer is smaller than what is to be written into it
+    /// ([`crate::World::snapshot_bytes`] for an image).
+    OutputTooSmall,
+    /// The bytes do not start with the magic of a world image (M12).
+    NotAnImage,
+    /// The image is of a format version this library does not read (M12).
+    ImageVersion,
+    /// The image is shorter or longer than its header says: cut short, or
+    /// with bytes after its end (M12).
+    ImageLength,
+    /// The image's checksum does not match its bytes: it was damaged (M12).
+    ImageChecksum,
+    /// The image's checksum matches, but what it holds is not a world this
+    /// library could have written: an unknown value, a count that does not
+    /// add up, a particle on an obstacle, a velocity out of range (M12).
+    ImageInvalid,
+    /// The image holds a world of another size or plan of planes than the
+    /// world it is loaded into (M12).
+    ImageMismatch,
 }
 
 impl Error {
@@ -118,6 +137,13 @@ impl Error {
             Error::NotAWorld => "the memory does not hold a live world",
             Error::NotOwned => "the world lives in caller memory; the caller frees it",
             Error::OutOfMemory => "the allocator refused the memory",
+            Error::OutputTooSmall => "the output buffer is too small",
+            Error::NotAnImage => "the bytes are not an mpca world image",
+            Error::ImageVersion => "the image is of a format version this library does not read",
+            Error::ImageLength => "the image is shorter or longer than its header says",
+            Error::ImageChecksum => "the image's checksum does not match: it was damaged",
+            Error::ImageInvalid => "the image does not hold a consistent world",
+            Error::ImageMismatch => "the image holds a world of another size or layout than this one",
         }
     }
 }

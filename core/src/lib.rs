@@ -58,6 +58,7 @@ mod partition;
 mod quant;
 mod query;
 pub mod rng;
+mod snapshot;
 mod step;
 #[cfg(target_has_atomic = "8")]
 mod tasks;
@@ -74,7 +75,8 @@ pub use owned::WorldBox;
 pub use step::Order;
 #[cfg(target_has_atomic = "8")]
 pub use tasks::{Host, MAX_TASKS};
-pub use query::{Cell, Particle, Particles, Stats};
+pub use query::{Cell, Particle, Particles, RegionStats, Stats};
+pub use snapshot::{image_description, IMAGE_VERSION};
 pub use world::{world_bytes, World, WORLD_ALIGN};
 
 /// The README's Rust example, compiled and run as a doctest so it stays true.

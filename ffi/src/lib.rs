@@ -38,6 +38,7 @@ mod obstacles;
 #[cfg(feature = "std")]
 mod parallel;
 mod particles;
+mod snapshot;
 mod status;
 mod world;
 
@@ -48,6 +49,7 @@ pub use obstacles::*;
 #[cfg(feature = "std")]
 pub use parallel::*;
 pub use particles::*;
+pub use snapshot::*;
 pub use status::*;
 pub use world::*;
 
@@ -73,6 +75,7 @@ const _: () = {
     use core::mem::{align_of, size_of};
     assert!(size_of::<mpca_desc>() == 168 && align_of::<mpca_desc>() == 8);
     assert!(size_of::<mpca_stats>() == 144 && align_of::<mpca_stats>() == 8);
+    assert!(size_of::<mpca_region_stats>() == 48 && align_of::<mpca_region_stats>() == 8);
     assert!(size_of::<mpca_particle>() == 32 && align_of::<mpca_particle>() == 4);
     assert!(size_of::<mpca_cell>() == 36 && align_of::<mpca_cell>() == 4);
     assert!(size_of::<mpca_emitter>() == 56 && align_of::<mpca_emitter>() == 4);
@@ -123,7 +126,7 @@ pub(crate) unsafe fn array<T: Copy, const N: usize>(p: *const T) -> Result<[T; N
 /// Whether `len` values of `T` fit in one object: at most `isize::MAX`
 /// bytes, the bound `core::slice::from_raw_parts` requires.
 #[inline]
-fn fits<T>(len: usize) -> bool {
+pub(crate) fn fits<T>(len: usize) -> bool {
     len <= isize::MAX as usize / core::mem::size_of::<T>().max(1)
 }
 

@@ -38,6 +38,9 @@ pub enum mpca_status {
     TaskIndex = 10,
     /// This task of the step was run already.
     TaskDone = 11,
+    /// Two memory ranges of the call overlap: an image and the memory of
+    /// the world it is saved from, loaded into or built in.
+    Overlap = 12,
     /// The dimension is neither 2 nor 3.
     BadDimension = 100,
     /// 3D worlds are not built into this library.
@@ -105,6 +108,21 @@ pub enum mpca_status {
     NotOwned = 131,
     /// The allocator refused the memory.
     OutOfMemory = 132,
+    /// The bytes do not start with the magic of a world image.
+    NotAnImage = 133,
+    /// The image is of a format version this library does not read.
+    ImageVersion = 134,
+    /// The image is shorter or longer than its header says: cut short, or
+    /// the length passed runs past its end.
+    ImageLength = 135,
+    /// The image's checksum does not match its bytes: it was damaged.
+    ImageChecksum = 136,
+    /// The image is well framed and its checksum matches, but it does not
+    /// hold a consistent world.
+    ImageInvalid = 137,
+    /// The image holds a world of another size or plan of memory than the
+    /// world it is loaded into.
+    ImageMismatch = 138,
     /// A flow drag rate is negative (M5.1b).
     BadDrag = 140,
     /// An error this version of the C ABI does not know by name.
@@ -149,6 +167,13 @@ impl From<Error> for mpca_status {
             Error::NotAWorld => S::BadHandle,
             Error::NotOwned => S::NotOwned,
             Error::OutOfMemory => S::OutOfMemory,
+            Error::OutputTooSmall => S::OutputTooSmall,
+            Error::NotAnImage => S::NotAnImage,
+            Error::ImageVersion => S::ImageVersion,
+            Error::ImageLength => S::ImageLength,
+            Error::ImageChecksum => S::ImageChecksum,
+            Error::ImageInvalid => S::ImageInvalid,
+            Error::ImageMismatch => S::ImageMismatch,
             _ => S::Unknown,
         }
     }
@@ -171,6 +196,7 @@ impl mpca_status {
             S::StaleTask => c"the ticket is not the parallel step in flight on this world",
             S::TaskIndex => c"the task index is not below the step's task count",
             S::TaskDone => c"this task of the step was run already",
+            S::Overlap => c"an image overlaps the memory of the world it is saved from, loaded into or built in",
             S::BadDimension => c"dimension must be 2 or 3",
             S::Dim3Disabled => c"3D worlds are not built into this library",
             S::SizeZero => c"a world size is zero",
@@ -204,6 +230,12 @@ impl mpca_status {
             S::BadLength => c"a per-cell input has the wrong length, or a length exceeds PTRDIFF_MAX bytes",
             S::NotOwned => c"the world lives in caller memory: deinit it and free the memory yourself",
             S::OutOfMemory => c"the allocator refused the memory",
+            S::NotAnImage => c"the bytes are not an mpca world image",
+            S::ImageVersion => c"the image is of a format version this library does not read",
+            S::ImageLength => c"the image is shorter or longer than its header says",
+            S::ImageChecksum => c"the image's checksum does not match: it was damaged",
+            S::ImageInvalid => c"the image does not hold a consistent world",
+            S::ImageMismatch => c"the image holds a world of another size or layout than this one",
             S::Unknown => c"an error this version of the C ABI does not name",
         }
     }
@@ -222,15 +254,16 @@ pub extern "C" fn mpca_status_message(status: u32) -> *const c_char {
 /// The status numbered `n`, if there is one.
 pub(crate) fn status_from_u32(n: u32) -> Option<mpca_status> {
     use mpca_status as S;
-    const ALL: [mpca_status; 46] = [
+    const ALL: [mpca_status; 53] = [
         S::Ok, S::NullPointer, S::BadHandle, S::Panic, S::BadStructSize, S::BadEnum, S::OutputTooSmall, S::NotASurface,
-        S::Busy, S::StaleTask, S::TaskIndex, S::TaskDone,
+        S::Busy, S::StaleTask, S::TaskIndex, S::TaskDone, S::Overlap,
         S::BadDimension, S::Dim3Disabled, S::SizeZero, S::SizeOdd, S::TooLarge, S::PeriodicMismatch,
         S::NotFinite, S::NegativeDt, S::BadVortex, S::BadDrag, S::RestitutionRange, S::MassRange, S::SpeedRange,
         S::Q16Disabled, S::FeatureDisabled, S::NotEnabled, S::CapacityRange, S::BufferTooSmall,
         S::OutOfBounds, S::CellOccupied, S::CellObstacle, S::NoParticle, S::MassTableFull,
         S::SurfaceTableFull, S::UndefinedNormal, S::EmitterTableFull, S::BadEmitter, S::LifetimeRange,
-        S::BadShape, S::BadResolution, S::BadLength, S::NotOwned, S::OutOfMemory, S::Unknown,
+        S::BadShape, S::BadResolution, S::BadLength, S::NotOwned, S::OutOfMemory,
+        S::NotAnImage, S::ImageVersion, S::ImageLength, S::ImageChecksum, S::ImageInvalid, S::ImageMismatch, S::Unknown,
     ];
     ALL.iter().copied().find(|s| *s as u32 == n)
 }

@@ -243,3 +243,52 @@ pub unsafe extern "C" fn mpca_world_hash(world: *const mpca_world, out_hash: *mu
         Ok(())
     })
 }
+
+/// The particles inside a box of cells and their motion, from
+/// mpca_world_region_stats. Set `struct_size` before the call.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct mpca_region_stats {
+    /// `sizeof(mpca_region_stats)`, set by the caller.
+    pub struct_size: u32,
+    /// Reserved, 0.
+    pub reserved: u32,
+    /// Particles in the box.
+    pub particles: u64,
+    /// Their momentum, sum m v.
+    pub momentum: [f64; 3],
+    /// Their kinetic energy, sum m |v|^2 / 2.
+    pub kinetic_energy: f64,
+}
+
+/// Fills `out` (whose `struct_size` the caller set) with the particles in
+/// the box of cells `min <= pos < max` (3 values each, per axis; the third
+/// is ignored in 2D) and their momentum and kinetic energy, summed as
+/// mpca_world_stats sums them: a box covering the world gives its figures
+/// exactly. For effects that trigger on what a region holds. An empty or
+/// reversed box (`min >= max` on an axis) is refused with
+/// `MPCA_STATUS_BAD_SHAPE`, one reaching beyond the world with
+/// `MPCA_STATUS_OUT_OF_BOUNDS`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mpca_world_region_stats(
+    world: *const mpca_world,
+    min: *const u32,
+    max: *const u32,
+    out: *mut mpca_region_stats,
+) -> mpca_status {
+    guard(|| {
+        let w = unsafe { world_ref(world)? };
+        let (min, max) = unsafe { (crate::array(min)?, crate::array(max)?) };
+        let out = unsafe { write(out)? };
+        check_size::<mpca_region_stats>(out.struct_size)?;
+        let r = w.region_stats(min, max)?;
+        *out = mpca_region_stats {
+            struct_size: out.struct_size,
+            reserved: 0,
+            particles: r.particles,
+            momentum: r.momentum,
+            kinetic_energy: r.kinetic_energy,
+        };
+        Ok(())
+    })
+}

@@ -73,6 +73,12 @@ static const struct symbol {
     SYMBOL(mpca_world_desc),
     SYMBOL(mpca_world_stats),
     SYMBOL(mpca_world_hash),
+    SYMBOL(mpca_world_region_stats),
+    SYMBOL(mpca_world_snapshot_bytes),
+    SYMBOL(mpca_world_save),
+    SYMBOL(mpca_world_load),
+    SYMBOL(mpca_desc_from_image),
+    SYMBOL(mpca_world_init_from_image),
 };
 
 #define SYMBOL_COUNT (sizeof SYMBOLS / sizeof SYMBOLS[0])

@@ -1155,6 +1155,7 @@ static const struct {
     STATUS(MPCA_STATUS_STALE_TASK),
     STATUS(MPCA_STATUS_TASK_INDEX),
     STATUS(MPCA_STATUS_TASK_DONE),
+    STATUS(MPCA_STATUS_OVERLAP),
     STATUS(MPCA_STATUS_BAD_DIMENSION),
     STATUS(MPCA_STATUS_DIM3_DISABLED),
     STATUS(MPCA_STATUS_SIZE_ZERO),
@@ -1188,6 +1189,12 @@ static const struct {
     STATUS(MPCA_STATUS_BAD_LENGTH),
     STATUS(MPCA_STATUS_NOT_OWNED),
     STATUS(MPCA_STATUS_OUT_OF_MEMORY),
+    STATUS(MPCA_STATUS_NOT_AN_IMAGE),
+    STATUS(MPCA_STATUS_IMAGE_VERSION),
+    STATUS(MPCA_STATUS_IMAGE_LENGTH),
+    STATUS(MPCA_STATUS_IMAGE_CHECKSUM),
+    STATUS(MPCA_STATUS_IMAGE_INVALID),
+    STATUS(MPCA_STATUS_IMAGE_MISMATCH),
     STATUS(MPCA_STATUS_UNKNOWN),
 };
 #define STATUS_COUNT (sizeof STATUSES / sizeof STATUSES[0])
@@ -1206,7 +1213,7 @@ static void message_cases(void) {
             CHECK(messages[j] == NULL || strcmp(messages[i], messages[j]) != 0);
         }
     }
-    const uint32_t unknown[] = {12, 99, 130, 133, 198, 200, 1000, 0x7fffffffu, UINT32_MAX};
+    const uint32_t unknown[] = {13, 99, 130, 139, 198, 200, 1000, 0x7fffffffu, UINT32_MAX};
     const char *first = TRACE(mpca_status_message(unknown[0]));
     CHECK(first != NULL && first[0] != '\0');
     for (unsigned i = 0; i < sizeof unknown / sizeof unknown[0] && first != NULL; i++) {

@@ -1,0 +1,817 @@
+//! M12 snapshots: a world written out as a byte image, and read back.
+//!
+//! The image is defined byte for byte in `docs/model.md` (M12). Every
+//! number in it is little-endian whatever the target, so an image written
+//! on one target loads on any other, into a world that hashes the same
+//! there. It holds the description, the step number, the counters and every
+//! plane that holds state; the row flags and summary words the step skips
+//! by (M3) are rebuilt from the occupancy instead of saved. A CRC-32 closes
+//! it.
+//!
+//! Reading is all or nothing: the framing, the checksum and then every value
+//! against the rules a live world keeps are checked before a byte of any
+//! world is written, so a refused image changes nothing.
+//!
+//! ```
+//! use mpca::{Description, World};
+//!
+//! let desc = Description::new_2d(16, 16);
+//! let mut memory = vec![0u8; mpca::world_bytes(&desc).unwrap()];
+//! let world = World::init(&desc, &mut memory).unwrap();
+//! world.add_particle([3, 4, 0], [0.5, 0.0, 0.0]).unwrap();
+//! world.step(5);
+//!
+//! let mut image = vec![0u8; world.snapshot_bytes()];
+//! world.save(&mut image).unwrap();
+//!
+//! // Into fresh memory, sized from the image alone.
+//! let mut other = vec![0u8; mpca::world_bytes(&mpca::image_description(&image).unwrap()).unwrap()];
+//! let copy = World::init_from_image(&image, &mut other).unwrap();
+//! assert_eq!(copy.state_hash(), world.state_hash());
+//! copy.step(10);
+//! world.step(10);
+//! assert_eq!(copy.state_hash(), world.state_hash());
+//!
+//! // A damaged image is refused.
+//! image[100] ^= 4;
+//! assert_eq!(world.load(&image), Err(mpca::Error::ImageChecksum));
+//! ```
+
+use core::mem::size_of;
+
+use crate::assign::Method;
+use crate::cells::Cells;
+use crate::desc::{Boundary, Collisions, Description, Drag, Drift, Forces, Quantization, Vortex};
+use crate::edit::storable;
+use crate::emitter::{checked, Emitter, Slot};
+use crate::layout::{mark, Layout};
+use crate::obstacle::Surface;
+use crate::quant::{with_quant, Quant};
+use crate::world::{Counters, World};
+use crate::Error;
+
+/// The first eight bytes of every image.
+const MAGIC: [u8; 8] = *b"MPCASNAP";
+
+/// The version of the image format this library writes, and the only one it
+/// reads.
+pub const IMAGE_VERSION: u32 = 1;
+
+/// Magic, version, a reserved word and the image's length.
+const HEAD: usize = 24;
+/// The description.
+const DESC: usize = 120;
+/// The step number, the counters and the table counts.
+const STATE: usize = 120;
+/// Everything before the planes.
+const FIXED: usize = HEAD + DESC + STATE;
+/// The CRC-32 at the end.
+const CHECKSUM: usize = 4;
+/// One surface table entry: cell, normal, restitution, mask flag.
+const SURFACE: usize = 24;
+/// One emitter: region, rate, velocity, spread, mass, lifetime, mass index.
+const EMITTER: usize = 56;
+
+/// CRC-32 as zlib, PNG and Ethernet compute it: the reflected polynomial
+/// 0xEDB88320, register preset to all ones and inverted at the end. A table
+/// of the remainders of every byte makes it one lookup a byte.
+const fn crc_table() -> [u32; 256] {
+    let mut table = [0u32; 256];
+    let mut byte = 0;
+    while byte < 256 {
+        let mut r = byte as u32;
+        let mut bit = 0;
+        while bit < 8 {
+            r = if r & 1 != 0 { (r >> 1) ^ 0xedb8_8320 } else { r >> 1 };
+            bit += 1;
+        }
+        table[byte] = r;
+        byte += 1;
+    }
+    table
+}
+
+static CRC_TABLE: [u32; 256] = crc_table();
+
+pub(crate) fn crc32(bytes: &[u8]) -> u32 {
+    !bytes.iter().fold(!0u32, |r, &b| CRC_TABLE[((r ^ u32::from(b)) & 0xff) as usize] ^ (r >> 8))
+}
+
+/// Writes values little-endian into an image whose length was computed
+/// beforehand ([`image_len`]), so nothing written can fall outside it.
+struct Put<'a> {
+    out: &'a mut [u8],
+    at: usize,
+}
+
+impl Put<'_> {
+    fn bytes(&mut self, b: &[u8]) {
+        self.out[self.at..self.at + b.len()].copy_from_slice(b);
+        self.at += b.len();
+    }
+    fn u8(&mut self, v: u8) {
+        self.bytes(&[v]);
+    }
+    fn u32(&mut self, v: u32) {
+        self.bytes(&v.to_le_bytes());
+    }
+    fn u64(&mut self, v: u64) {
+        self.bytes(&v.to_le_bytes());
+    }
+    fn f32(&mut self, v: f32) {
+        self.u32(v.to_bits());
+    }
+}
+
+/// Reads values little-endian from an image, front to back.
+struct Get<'a> {
+    rest: &'a [u8],
+}
+
+impl<'a> Get<'a> {
+    fn take(&mut self, n: usize) -> Result<&'a [u8], Error> {
+        if n > self.rest.len() {
+            return Err(Error::ImageInvalid);
+        }
+        let (head, rest) = self.rest.split_at(n);
+        self.rest = rest;
+        Ok(head)
+    }
+    fn array<const N: usize>(&mut self) -> Result<[u8; N], Error> {
+        let mut a = [0; N];
+        a.copy_from_slice(self.take(N)?);
+        Ok(a)
+    }
+    fn u8(&mut self) -> Result<u8, Error> {
+        Ok(self.array::<1>()?[0])
+    }
+    fn flag(&mut self) -> Result<bool, Error> {
+        match self.u8()? {
+            0 => Ok(false),
+            1 => Ok(true),
+            _ => Err(Error::ImageInvalid),
+        }
+    }
+    fn u32(&mut self) -> Result<u32, Error> {
+        Ok(u32::from_le_bytes(self.array()?))
+    }
+    fn u64(&mut self) -> Result<u64, Error> {
+        Ok(u64::from_le_bytes(self.array()?))
+    }
+    fn f32(&mut self) -> Result<f32, Error> {
+        Ok(f32::from_bits(self.u32()?))
+    }
+    /// `n` reserved bytes, which must be zero.
+    fn zeros(&mut self, n: usize) -> Result<(), Error> {
+        if self.take(n)?.iter().all(|&b| b == 0) { Ok(()) } else { Err(Error::ImageInvalid) }
+    }
+}
+
+/// Word `i` of a plane of little-endian `u32` in an image.
+fn le_u32(bytes: &[u8], i: usize) -> u32 {
+    let mut a = [0; 4];
+    a.copy_from_slice(&bytes[4 * i..4 * i + 4]);
+    u32::from_le_bytes(a)
+}
+
+/// Word `i` of a plane of little-endian `u64` in an image.
+fn le_u64(bytes: &[u8], i: usize) -> u64 {
+    let mut a = [0; 8];
+    a.copy_from_slice(&bytes[8 * i..8 * i + 8]);
+    u64::from_le_bytes(a)
+}
+
+/// A stored velocity component of `width` bytes (1 or 2) at the start of
+/// `bytes`.
+fn component(bytes: &[u8], width: usize) -> i32 {
+    if width == 1 { i32::from(bytes[0] as i8) } else { i32::from(i16::from_le_bytes([bytes[0], bytes[1]])) }
+}
+
+/// Bytes of a stored velocity component, and stored steps per unit speed.
+fn width_and_scale(q: Quantization) -> (usize, i32) {
+    match q {
+        Quantization::Bits8 => (1, 127),
+        Quantization::Bits16 => (2, 32767),
+    }
+}
+
+/// Calls `f(row, x)` for every set bit of a bit plane laid out as `l`
+/// plans it, whose word `i` is `word(i)`, in cell order (x fastest).
+fn each_bit(l: &Layout, word: impl Fn(usize) -> u64, mut f: impl FnMut(usize, usize)) {
+    for i in 0..l.occupancy.len / 8 {
+        let mut bits = word(i);
+        let (row, x0) = (i / l.row_words, (i % l.row_words) * 64);
+        while bits != 0 {
+            let b = bits.trailing_zeros() as usize;
+            bits &= bits - 1;
+            f(row, x0 + b);
+        }
+    }
+}
+
+/// Bytes of the image of a world described by `d`, planned as `l`, with
+/// these counts of particles and used table entries.
+fn image_len(d: &Description, l: &Layout, particles: usize, masses: usize, surfaces: usize, emitters: usize) -> Option<usize> {
+    let (width, _) = width_and_scale(d.quantization);
+    let per_particle = d.dim as usize * width + usize::from(d.per_particle_mass) + 2 * usize::from(d.lifetimes);
+    [
+        FIXED,
+        l.occupancy.len,
+        l.obstacle.len,
+        particles.checked_mul(per_particle)?,
+        l.field.len,
+        l.potential.len,
+        masses.checked_mul(4)?,
+        surfaces.checked_mul(SURFACE)?,
+        emitters.checked_mul(EMITTER)?,
+        CHECKSUM,
+    ]
+    .iter()
+    .try_fold(0usize, |sum, &n| sum.checked_add(n))
+}
+
+fn put_desc(p: &mut Put<'_>, d: &Description) {
+    // Taken apart whole, so that a field added to Description does not
+    // compile here until the image holds it (under a new IMAGE_VERSION).
+    let Description {
+        dim,
+        size,
+        boundary,
+        mass,
+        per_particle_mass,
+        mass_classes,
+        obstacles,
+        surface_capacity,
+        forces,
+        gravity,
+        vortex,
+        restitution,
+        wall_restitution,
+        dt,
+        seed,
+        quantization,
+        drift,
+        method,
+        collisions,
+        contacts,
+        energy_neutral,
+        drag,
+        emitter_capacity,
+        lifetimes,
+    } = *d;
+    let Forces { uniform, field, potential, vortex: swirl } = forces;
+    let Vortex { centre, core_radius, circulation } = vortex;
+    let Drag { rate, wind, vortex: flow } = drag;
+    p.u32(dim);
+    size.iter().for_each(|&s| p.u32(s));
+    p.u64(seed);
+    boundary.iter().flatten().for_each(|&b| p.u8(b as u8));
+    p.u8(quantization as u8);
+    p.u8(drift as u8);
+    p.u8(method as u8);
+    p.u8(collisions as u8);
+    for on in [per_particle_mass, obstacles, lifetimes, contacts, uniform, field, potential, swirl] {
+        p.u8(u8::from(on));
+    }
+    p.u8(u8::from(energy_neutral));
+    p.u8(u8::from(flow));
+    p.f32(mass);
+    p.u32(mass_classes);
+    p.u32(surface_capacity);
+    p.u32(emitter_capacity);
+    gravity.iter().for_each(|&g| p.f32(g));
+    centre.iter().for_each(|&c| p.f32(c));
+    p.f32(core_radius);
+    p.f32(circulation);
+    p.f32(restitution);
+    p.f32(wall_restitution);
+    p.f32(dt);
+    p.f32(rate);
+    wind.iter().for_each(|&w| p.f32(w));
+    p.bytes(&[0; 4]);
+}
+
+fn get_desc(g: &mut Get<'_>) -> Result<Description, Error> {
+    let bad = Error::ImageInvalid;
+    let dim = g.u32()?;
+    let size = [g.u32()?, g.u32()?, g.u32()?];
+    let seed = g.u64()?;
+    let mut boundary = [[Boundary::Periodic; 2]; 3];
+    for face in boundary.iter_mut().flatten() {
+        *face = match g.u8()? {
+            0 => Boundary::Periodic,
+            1 => Boundary::Wall,
+            2 => Boundary::Open,
+            _ => return Err(bad),
+        };
+    }
+    let quantization = match g.u8()? {
+        8 => Quantization::Bits8,
+        16 => Quantization::Bits16,
+        _ => return Err(bad),
+    };
+    let drift = match g.u8()? {
+        0 => Drift::Paper,
+        1 => Drift::Calibrated,
+        _ => return Err(bad),
+    };
+    let method = match g.u8()? {
+        0 => Method::Exhaustive,
+        1 => Method::ExactFast,
+        2 => Method::Greedy,
+        _ => return Err(bad),
+    };
+    let collisions = match g.u8()? {
+        0 => Collisions::Paper,
+        1 => Collisions::SpeedLimited,
+        _ => return Err(bad),
+    };
+    let (per_particle_mass, obstacles, lifetimes, contacts) = (g.flag()?, g.flag()?, g.flag()?, g.flag()?);
+    let forces = Forces { uniform: g.flag()?, field: g.flag()?, potential: g.flag()?, vortex: g.flag()? };
+    let (energy_neutral, flow) = (g.flag()?, g.flag()?);
+    let mass = g.f32()?;
+    let (mass_classes, surface_capacity, emitter_capacity) = (g.u32()?, g.u32()?, g.u32()?);
+    let gravity = [g.f32()?, g.f32()?, g.f32()?];
+    let vortex = Vortex { centre: [g.f32()?, g.f32()?], core_radius: g.f32()?, circulation: g.f32()? };
+    let (restitution, wall_restitution, dt) = (g.f32()?, g.f32()?, g.f32()?);
+    let drag = Drag { rate: g.f32()?, wind: [g.f32()?, g.f32()?, g.f32()?], vortex: flow };
+    g.zeros(4)?;
+    Ok(Description {
+        dim,
+        size,
+        boundary,
+        mass,
+        per_particle_mass,
+        mass_classes,
+        obstacles,
+        surface_capacity,
+        forces,
+        gravity,
+        vortex,
+        restitution,
+        wall_restitution,
+        dt,
+        seed,
+        quantization,
+        drift,
+        method,
+        collisions,
+        contacts,
+        energy_neutral,
+        drag,
+        emitter_capacity,
+        lifetimes,
+    })
+}
+
+fn put_surface(p: &mut Put<'_>, s: &Surface) {
+    p.u32(s.cell);
+    s.normal.iter().for_each(|&c| p.f32(c));
+    p.f32(s.restitution);
+    p.u32(s.from_mask);
+}
+
+fn get_surface(b: &[u8]) -> Surface {
+    let f = |i| f32::from_bits(le_u32(b, i));
+    Surface { cell: le_u32(b, 0), normal: [f(1), f(2), f(3)], restitution: f(4), from_mask: le_u32(b, 5) }
+}
+
+fn put_slot(p: &mut Put<'_>, s: &Slot) {
+    let e = &s.emitter;
+    e.min.iter().chain(&e.max).for_each(|&c| p.u32(c));
+    p.f32(e.rate);
+    e.velocity.iter().for_each(|&c| p.f32(c));
+    p.f32(e.spread);
+    p.f32(e.mass);
+    p.u32(e.lifetime);
+    p.u32(s.mass_index);
+}
+
+fn get_slot(b: &[u8]) -> Slot {
+    let u = |i| le_u32(b, i);
+    let f = |i| f32::from_bits(le_u32(b, i));
+    let emitter = Emitter {
+        min: [u(0), u(1), u(2)],
+        max: [u(3), u(4), u(5)],
+        rate: f(6),
+        velocity: [f(7), f(8), f(9)],
+        spread: f(10),
+        mass: f(11),
+        lifetime: u(12),
+    };
+    Slot { emitter, mass_index: u(13) }
+}
+
+/// An image checked in full; its planes are still the image's bytes.
+struct Image<'a> {
+    desc: Description,
+    layout: Layout,
+    step: u64,
+    counters: Counters,
+    masses: usize,
+    surfaces: usize,
+    emitters: usize,
+    occupancy: &'a [u8],
+    obstacle: &'a [u8],
+    velocity: &'a [u8],
+    mass_index: &'a [u8],
+    life: &'a [u8],
+    field: &'a [u8],
+    potential: &'a [u8],
+    mass_table: &'a [u8],
+    surface: &'a [u8],
+    emitter: &'a [u8],
+}
+
+/// Checks an image in full and returns it, or the first reason it is
+/// refused. In this order: the magic (`NotAnImage`), enough bytes for the
+/// head (`ImageLength`), the version (`ImageVersion`), the length the head
+/// states (`ImageLength`), the checksum (`ImageChecksum`); then the
+/// description, which this build may not hold (`Dim3Disabled`,
+/// `Q16Disabled`, `FeatureDisabled`, `TooLarge`), and everything else
+/// (`ImageInvalid`).
+fn read(image: &[u8]) -> Result<Image<'_>, Error> {
+    let m = image.len().min(MAGIC.len());
+    if image[..m] != MAGIC[..m] {
+        return Err(Error::NotAnImage);
+    }
+    if image.len() < HEAD {
+        return Err(Error::ImageLength);
+    }
+    let mut g = Get { rest: &image[MAGIC.len()..] };
+    if g.u32()? != IMAGE_VERSION {
+        return Err(Error::ImageVersion);
+    }
+    let reserved = g.u32()?;
+    if g.u64()? != image.len() as u64 {
+        return Err(Error::ImageLength);
+    }
+    let (body, sum) = image.split_at(image.len() - CHECKSUM);
+    if crc32(body) != le_u32(sum, 0) {
+        return Err(Error::ImageChecksum);
+    }
+    // From here on the bytes are what the writer wrote; a refusal means the
+    // writer was not this library (or a build with other parts).
+    let bad = Error::ImageInvalid;
+    if reserved != 0 || image.len() < FIXED + CHECKSUM {
+        return Err(bad);
+    }
+    let desc = get_desc(&mut g)?;
+    let layout = Layout::of(&desc).map_err(|e| match e {
+        Error::Dim3Disabled | Error::Q16Disabled | Error::FeatureDisabled | Error::TooLarge => e,
+        _ => bad,
+    })?;
+    // A 2D world keeps 1 as its third size (World::init).
+    if desc.dim == 2 && desc.size[2] != 1 {
+        return Err(bad);
+    }
+    let step = g.u64()?;
+    let [particles, emitted, exited, expired, shortfall, collisions, clamps] =
+        [g.u64()?, g.u64()?, g.u64()?, g.u64()?, g.u64()?, g.u64()?, g.u64()?];
+    // 16 bytes in the image; the world counts in a u64.
+    let clamp_energy = u64::try_from(u128::from_le_bytes(g.array()?)).map_err(|_| Error::ImageInvalid)?;
+    let [displaced, processed, skipped] = [g.u64()?, g.u64()?, g.u64()?];
+    let counters =
+        Counters { particles, emitted, exited, expired, shortfall, collisions, clamps, clamp_energy, displaced, processed, skipped };
+    let [masses, surfaces, emitters] = [g.u32()?, g.u32()?, g.u32()?].map(|c| c as usize);
+    g.zeros(4)?;
+    let mass_room = if desc.per_particle_mass { 1..=desc.mass_classes as usize } else { 0..=0 };
+    if !mass_room.contains(&masses)
+        || surfaces > layout.surface.len / size_of::<Surface>()
+        || emitters > layout.emitters.len / size_of::<Slot>()
+        || particles > layout.cells as u64
+    {
+        return Err(bad);
+    }
+    if image_len(&desc, &layout, particles as usize, masses, surfaces, emitters) != Some(image.len()) {
+        return Err(bad);
+    }
+    let (width, _) = width_and_scale(desc.quantization);
+    let n = particles as usize;
+    let dim = desc.dim as usize;
+    let img = Image {
+        desc,
+        layout,
+        step,
+        counters,
+        masses,
+        surfaces,
+        emitters,
+        occupancy: g.take(layout.occupancy.len)?,
+        obstacle: g.take(layout.obstacle.len)?,
+        velocity: g.take(n * dim * width)?,
+        mass_index: g.take(if desc.per_particle_mass { n } else { 0 })?,
+        life: g.take(if desc.lifetimes { 2 * n } else { 0 })?,
+        field: g.take(layout.field.len)?,
+        potential: g.take(layout.potential.len)?,
+        mass_table: g.take(4 * masses)?,
+        surface: g.take(SURFACE * surfaces)?,
+        emitter: g.take(EMITTER * emitters)?,
+    };
+    check(&img)?;
+    Ok(img)
+}
+
+/// The rules a live world keeps, held against an image's content.
+fn check(img: &Image<'_>) -> Result<(), Error> {
+    let bad = Err(Error::ImageInvalid);
+    let (d, l) = (&img.desc, &img.layout);
+    let dim = d.dim as usize;
+
+    // The bit planes: nothing in the padding after a row's last cell, no
+    // particle on an obstacle, as many particles as the counter says.
+    let tail = if l.n[0] % 64 == 0 { 0 } else { u64::MAX << (l.n[0] % 64) };
+    let mut count = 0u64;
+    for i in 0..l.occupancy.len / 8 {
+        let occ = le_u64(img.occupancy, i);
+        let obs = if d.obstacles { le_u64(img.obstacle, i) } else { 0 };
+        if (i % l.row_words == l.row_words - 1 && (occ | obs) & tail != 0) || occ & obs != 0 {
+            return bad;
+        }
+        count += u64::from(occ.count_ones());
+    }
+    if count != img.counters.particles {
+        return bad;
+    }
+
+    // Velocities the step could have stored (M1), mass classes in use.
+    let (width, scale) = width_and_scale(d.quantization);
+    for v in img.velocity.chunks_exact(dim * width) {
+        let mut q = [0i32; 3];
+        for k in 0..dim {
+            q[k] = component(&v[k * width..], width);
+        }
+        if q.iter().any(|c| c.abs() > scale) || !storable(q, scale) {
+            return bad;
+        }
+    }
+    if img.mass_index.iter().any(|&i| usize::from(i) >= img.masses) {
+        return bad;
+    }
+
+    // Force planes: finite, as the set functions require.
+    let floats = |plane: &[u8]| (0..plane.len() / 4).all(|i| f32::from_bits(le_u32(plane, i)).is_finite());
+    if !floats(img.field) || !floats(img.potential) {
+        return bad;
+    }
+
+    // The mass table: distinct valid masses, class 0 the description's.
+    let table = |i: usize| f32::from_bits(le_u32(img.mass_table, i));
+    for i in 0..img.masses {
+        if crate::desc::mass(table(i)).is_err() || (0..i).any(|j| table(j).to_bits() == table(i).to_bits()) {
+            return bad;
+        }
+    }
+    if img.masses > 0 && table(0).to_bits() != d.mass.to_bits() {
+        return bad;
+    }
+
+    // The surface table: obstacle cells in increasing order, unit normals
+    // in the world's plane, restitutions in [0, 1].
+    let mut last = None;
+    for b in img.surface.chunks_exact(SURFACE) {
+        let s = get_surface(b);
+        let cell = s.cell as usize;
+        if cell >= l.cells || last.is_some_and(|c| c >= s.cell) {
+            return bad;
+        }
+        last = Some(s.cell);
+        let (row, x) = (cell / l.n[0], cell % l.n[0]);
+        let bit = row * l.row_words * 64 + x;
+        if le_u64(img.obstacle, bit / 64) >> (bit % 64) & 1 == 0 {
+            return bad;
+        }
+        // normalise() leaves |N|^2 within a few 1e-7 of 1; NaN is not unit.
+        let unit = (crate::vector::dot(s.normal, s.normal) - 1.0).abs() <= 1e-4;
+        if !unit || (dim == 2 && s.normal[2] != 0.0) {
+            return bad;
+        }
+        if crate::desc::restitution(s.restitution).is_err() || s.from_mask > 1 {
+            return bad;
+        }
+    }
+
+    // Emitters: what add_emitter accepts, stored as it stores them.
+    for b in img.emitter.chunks_exact(EMITTER) {
+        let s = get_slot(b);
+        let e = s.emitter;
+        if checked(e, dim, l.n, d.lifetimes) != Ok(e) {
+            return bad;
+        }
+        let class = s.mass_index as usize;
+        let known = if d.per_particle_mass { class < img.masses && table(class).to_bits() == e.mass.to_bits() } else { class == 0 && e.mass.to_bits() == d.mass.to_bits() };
+        if !known {
+            return bad;
+        }
+    }
+    Ok(())
+}
+
+/// Writes a checked image into `w`, whose plan is the image's. Nothing here
+/// can fail.
+fn apply(w: &mut World, img: &Image<'_>) {
+    let (d, l) = (img.desc, img.layout);
+    let dim = d.dim as usize;
+    w.head.desc = d;
+    w.head.step = img.step;
+    w.head.counters = img.counters;
+    w.head.masses = img.masses as u32;
+    w.head.surfaces = img.surfaces as u32;
+    w.head.emitters = img.emitters as u32;
+    with_quant!(d.quantization, Q => {
+        let (_, p) = w.planes::<Q>();
+        for (i, word) in p.occupancy.iter_mut().enumerate() {
+            *word = le_u64(img.occupancy, i);
+        }
+        for (i, word) in p.obstacle.iter_mut().enumerate() {
+            *word = le_u64(img.obstacle, i);
+        }
+        // Values in empty cells are never read; zero, so that equal images
+        // make equal memory.
+        p.velocity.fill(Q::default());
+        p.mass_index.fill(0);
+        p.life.fill(0);
+        // The skip summaries (M3), exact: flagged where a particle is.
+        p.rows.fill(0);
+        p.words.fill(0);
+        let (rows, words) = (Cells::new(&mut *p.rows), Cells::new(&mut *p.words));
+        let width = size_of::<Q>();
+        let mut i = 0;
+        each_bit(&l, |k| le_u64(img.occupancy, k), |row, x| {
+            mark(rows, words, l.summary_words, row, x);
+            let cell = x + l.n[0] * row;
+            for k in 0..dim {
+                p.velocity[cell * dim + k] = Q::from_int(component(&img.velocity[(i * dim + k) * width..], width));
+            }
+            if d.per_particle_mass {
+                p.mass_index[cell] = img.mass_index[i];
+            }
+            if d.lifetimes {
+                p.life[cell] = u16::from_le_bytes([img.life[2 * i], img.life[2 * i + 1]]);
+            }
+            i += 1;
+        });
+        for (k, f) in p.field.iter_mut().enumerate() {
+            *f = f32::from_bits(le_u32(img.field, k));
+        }
+        for (k, u) in p.potential.iter_mut().enumerate() {
+            *u = f32::from_bits(le_u32(img.potential, k));
+        }
+        p.mass_table.fill(0.0);
+        for (k, m) in p.mass_table.iter_mut().take(img.masses).enumerate() {
+            *m = f32::from_bits(le_u32(img.mass_table, k));
+        }
+        p.surface.fill(Surface::default());
+        for (s, b) in p.surface.iter_mut().zip(img.surface.chunks_exact(SURFACE)) {
+            *s = get_surface(b);
+        }
+        p.emitters.fill(Slot::default());
+        for (s, b) in p.emitters.iter_mut().zip(img.emitter.chunks_exact(EMITTER)) {
+            *s = get_slot(b);
+        }
+    });
+}
+
+/// The description of the world `image` holds, after checking the whole
+/// image as [`World::load`] does. [`crate::world_bytes`] of it is the memory
+/// [`World::init_from_image`] needs.
+pub fn image_description(image: &[u8]) -> Result<Description, Error> {
+    read(image).map(|img| img.desc)
+}
+
+impl World {
+    /// Bytes of the image [`World::save`] writes now: a fixed 248 bytes,
+    /// the occupancy and obstacle bit planes, a few bytes per particle,
+    /// the force planes, and the used entries of the tables (M12).
+    pub fn snapshot_bytes(&self) -> usize {
+        let h = &self.head;
+        let occupancy: &[u64] = self.plane(h.layout.occupancy);
+        let particles = occupancy.iter().map(|w| w.count_ones() as usize).sum();
+        image_len(&h.desc, &h.layout, particles, h.masses as usize, h.surfaces as usize, h.emitters as usize).unwrap_or(usize::MAX)
+    }
+
+    /// Writes the world's image (M12) to the start of `out` and returns its
+    /// length, [`World::snapshot_bytes`]. An `out` shorter than that is
+    /// refused with `OutputTooSmall`, and nothing is written.
+    pub fn save(&self, out: &mut [u8]) -> Result<usize, Error> {
+        let len = self.snapshot_bytes();
+        let out = out.get_mut(..len).ok_or(Error::OutputTooSmall)?;
+        let h = &self.head;
+        let l = h.layout;
+        let dim = self.dim();
+        let mut p = Put { out, at: 0 };
+        p.bytes(&MAGIC);
+        p.u32(IMAGE_VERSION);
+        p.u32(0);
+        p.u64(len as u64);
+        put_desc(&mut p, &h.desc);
+        p.u64(h.step);
+        let Counters { particles, emitted, exited, expired, shortfall, collisions, clamps, clamp_energy, displaced, processed, skipped } =
+            h.counters;
+        for c in [particles, emitted, exited, expired, shortfall, collisions, clamps] {
+            p.u64(c);
+        }
+        p.bytes(&u128::from(clamp_energy).to_le_bytes());
+        for c in [displaced, processed, skipped] {
+            p.u64(c);
+        }
+        for c in [h.masses, h.surfaces, h.emitters, 0] {
+            p.u32(c);
+        }
+        let occupancy: &[u64] = self.plane(l.occupancy);
+        occupancy.iter().for_each(|&w| p.u64(w));
+        self.plane::<u64>(l.obstacle).iter().for_each(|&w| p.u64(w));
+        // Per particle, in cell order: velocities, mass classes, lifetimes.
+        let each_particle = |f: &mut dyn FnMut(usize)| each_bit(&l, |i| occupancy[i], |row, x| f(x + l.n[0] * row));
+        with_quant!(h.desc.quantization, Q => {
+            let v: &[Q] = self.plane(l.velocity);
+            each_particle(&mut |cell| {
+                for k in 0..dim {
+                    // The low byte of an i16 is the i8 itself.
+                    p.bytes(&(v[cell * dim + k].to_int() as i16).to_le_bytes()[..size_of::<Q>()]);
+                }
+            });
+        });
+        if h.desc.per_particle_mass {
+            let index: &[u8] = self.plane(l.mass_index);
+            each_particle(&mut |cell| p.u8(index[cell]));
+        }
+        if h.desc.lifetimes {
+            let life: &[u16] = self.plane(l.life);
+            each_particle(&mut |cell| p.bytes(&life[cell].to_le_bytes()));
+        }
+        self.plane::<f32>(l.field).iter().for_each(|&f| p.f32(f));
+        self.plane::<f32>(l.potential).iter().for_each(|&u| p.f32(u));
+        self.plane::<f32>(l.mass_table)[..h.masses as usize].iter().for_each(|&m| p.f32(m));
+        self.plane::<Surface>(l.surface)[..h.surfaces as usize].iter().for_each(|s| put_surface(&mut p, s));
+        self.plane::<Slot>(l.emitters)[..h.emitters as usize].iter().for_each(|s| put_slot(&mut p, s));
+        let crc = crc32(&p.out[..len - CHECKSUM]);
+        p.u32(crc);
+        debug_assert_eq!(p.at, len);
+        Ok(len)
+    }
+
+    /// Makes this world the one `image` holds (M12): its description,
+    /// step number, counters, particles, obstacles, force planes and tables,
+    /// so that it hashes equal to the saved world and steps on exactly as
+    /// that world would have.
+    ///
+    /// This world must have the image's plan of memory: the same sizes,
+    /// velocity width and parts (obstacles, per-particle masses, lifetimes,
+    /// force field, potential) and the same capacities (mass classes,
+    /// surface and emitter tables); anything else is refused with
+    /// `ImageMismatch`. What does not change the plan (seed, forces,
+    /// restitutions, method, faces...) is taken from the image. A world built
+    /// from [`image_description`] always fits.
+    ///
+    /// The whole image is checked before anything is written, and a refused
+    /// image leaves the world as it was: `NotAnImage` (wrong magic),
+    /// `ImageLength` (cut short, or bytes after its end), `ImageVersion`,
+    /// `ImageChecksum` (damaged), `ImageInvalid` (well framed, but not a
+    /// world this library could have written), or the error of a part this
+    /// build left out (`Dim3Disabled`, `Q16Disabled`, `FeatureDisabled`).
+    pub fn load(&mut self, image: &[u8]) -> Result<(), Error> {
+        let img = read(image)?;
+        if img.layout != self.head.layout {
+            return Err(Error::ImageMismatch);
+        }
+        apply(self, &img);
+        Ok(())
+    }
+
+    /// Builds the world `image` holds in `memory`, as [`World::init`]
+    /// builds an empty one: `memory` must hold at least
+    /// [`crate::world_bytes`] of [`image_description`]. The image is
+    /// checked in full before a byte of `memory` is written.
+    pub fn init_from_image<'a>(image: &[u8], memory: &'a mut [u8]) -> Result<&'a mut World, Error> {
+        let img = read(image)?;
+        let world = World::init(&img.desc, memory)?;
+        apply(world, &img);
+        Ok(world)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn crc32_is_the_zlib_one() {
+        // The check value of the CRC catalogue for CRC-32/ISO-HDLC.
+        assert_eq!(crc32(b"123456789"), 0xcbf4_3926);
+        assert_eq!(crc32(b""), 0);
+    }
+
+    #[test]
+    fn the_fixed_part_has_the_sizes_the_format_states() {
+        let mut out = [0u8; FIXED];
+        let mut p = Put { out: &mut out, at: HEAD };
+        put_desc(&mut p, &Description::new_3d(4, 4, 4));
+        assert_eq!(p.at, HEAD + DESC);
+        assert_eq!(size_of::<Surface>(), SURFACE);
+        assert_eq!(size_of::<Slot>(), EMITTER);
+        let mut g = Get { rest: &out[HEAD..HEAD + DESC] };
+        assert_eq!(get_desc(&mut g), Ok(Description::new_3d(4, 4, 4)));
+        assert!(g.rest.is_empty());
+    }
+}
