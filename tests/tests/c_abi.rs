@@ -317,6 +317,7 @@ impl Elf {
     const SHT_DYNSYM: u32 = 11;
     const SHT_DYNAMIC: u32 = 6;
     const DT_NEEDED: u64 = 1;
+    const DT_SONAME: u64 = 14;
 
     fn read(path: &Path) -> Elf {
         let data = std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
@@ -350,11 +351,21 @@ impl Elf {
 
     /// The DT_NEEDED entries of the dynamic section.
     fn needed(&self) -> Vec<String> {
+        self.dynamic_strings(Self::DT_NEEDED)
+    }
+
+    /// The DT_SONAME entry of the dynamic section, if any.
+    fn soname(&self) -> Option<String> {
+        self.dynamic_strings(Self::DT_SONAME).into_iter().next()
+    }
+
+    /// The strings of the dynamic section's entries tagged `tag`.
+    fn dynamic_strings(&self, tag: u64) -> Vec<String> {
         let sections = self.sections();
         let mut names = Vec::new();
         for s in sections.iter().filter(|s| s.kind == Self::SHT_DYNAMIC) {
             for e in (s.offset..s.offset + s.size).step_by(16) {
-                if self.uint(e, 8) == Self::DT_NEEDED {
+                if self.uint(e, 8) == tag {
                     names.push(self.string(&sections[s.link], self.uint(e + 8, 8) as usize));
                 }
             }
@@ -411,7 +422,17 @@ fn static_and_shared_programs_link_the_library_they_should() {
     assert!(!needed.iter().any(is_mpca), "errors (linked with libmpca.a) needs {needed:?}");
     assert!(needed.iter().any(|n| n.starts_with("libc.so")), "the ELF parse found no libc in {needed:?}");
     let needed = Elf::read(&scenes().exe).needed();
-    assert!(needed.iter().any(is_mpca), "scenes (linked with -lmpca) needs only {needed:?}");
+    // By the SONAME, not the file name it was linked from.
+    assert!(needed.iter().any(|n| n == clib::soname()), "scenes (linked with -lmpca) needs only {needed:?}");
+}
+
+/// libmpca.so as cargo builds it carries the SONAME `libmpca.so.MAJOR`
+/// (ffi/build.rs), the name scripts/install.sh gives its link, so programs
+/// keep loading any later library of the same major version.
+#[test]
+fn the_shared_library_carries_its_soname() {
+    let soname = Elf::read(&library().join("libmpca.so")).soname();
+    assert_eq!(soname.as_deref(), Some(clib::soname()), "the SONAME of libmpca.so");
 }
 
 #[test]
