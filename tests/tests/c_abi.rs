@@ -13,6 +13,8 @@
 //!   by what the world then does: 2D half-space normals, a vortex with a
 //!   tiny core, a world rebuilt from its own export.
 //! - `header_only.c`: `include/mpca.h` alone, as C99 and as C++11.
+//! - `cpp_wrapper.cpp` (linked statically): `include/mpca.hpp`, the C++11
+//!   wrapper, against the C functions it wraps.
 //!
 //! With `MPCA_C_SANITIZE=1` every program is built with AddressSanitizer
 //! (LeakSanitizer included) and UndefinedBehaviorSanitizer, into a separate
@@ -34,6 +36,9 @@ use mpca::{Boundary, Collisions, Description, Drift, Emitter, Method, Quantizati
 /// Error cases `errors.c` must try. It tries 1,795 today; the margin is
 /// for cases merged or reworded, not for groups dropped.
 const MIN_ERROR_CASES: u64 = 1700;
+
+/// Checks `cpp_wrapper.cpp` must make: 213 today (a THROWS is three).
+const MIN_CPP_CHECKS: u32 = 200;
 
 const SANITIZE_FLAGS: [&str; 3] = ["-fsanitize=address,undefined", "-fno-omit-frame-pointer", "-fno-sanitize-recover=all"];
 
@@ -247,6 +252,27 @@ fn edges() -> &'static Run {
 fn parallel() -> &'static Run {
     static RUN: OnceLock<Run> = OnceLock::new();
     RUN.get_or_init(|| run(build("parallel", &["parallel.c", "check.c"], Link::Static), ""))
+}
+
+/// `cpp_wrapper.cpp`, compiled as C++11 with the same strict flags and
+/// linked with `libmpca.a`, run once per test process.
+fn cpp_wrapper() -> &'static Run {
+    static RUN: OnceLock<Run> = OnceLock::new();
+    RUN.get_or_init(|| {
+        let exe = out_dir().join("cpp_wrapper");
+        let mut cmd = compiler(true, false);
+        cmd.arg("-pthread").arg("-o").arg(&exe).arg(root().join("tests/c/cpp_wrapper.cpp"));
+        cmd.arg(library().join("libmpca.a")).args(["-lm", "-lpthread", "-ldl"]);
+        let out = cmd.output().expect("the C++ compiler runs");
+        assert!(
+            out.status.success(),
+            "compiling cpp_wrapper failed:\n{}\n{}{}",
+            command_line(&cmd),
+            String::from_utf8_lossy(&out.stdout),
+            String::from_utf8_lossy(&out.stderr)
+        );
+        run(exe, "")
+    })
 }
 
 /// `include/mpca.h` without its comments.
@@ -674,7 +700,7 @@ fn exports_from_c_agree_with_the_cells_and_the_density() {
 
 #[test]
 fn sanitizers_are_linked_in_exactly_when_asked() {
-    for run in [errors(), scenes(), reuse(), edges(), parallel()] {
+    for run in [errors(), scenes(), reuse(), edges(), parallel(), cpp_wrapper()] {
         let printed = run.value("sanitizer: ");
         let needed = Elf::read(&run.exe).needed();
         let asan = needed.iter().any(|n| n.starts_with("libasan.so"));
@@ -783,6 +809,28 @@ fn the_readme_c_example_builds_and_runs() {
     assert!(out.status.success(), "exit {}: {stdout}{}", out.status, String::from_utf8_lossy(&out.stderr));
     let line = stdout.lines().next().unwrap_or_default();
     assert!(line.starts_with("64 particles after 100 steps, momentum y -"), "{line}");
+}
+
+// --- The C++ wrapper ------------------------------------------------------------
+
+/// `include/mpca.hpp` compiles as C++11 with every warning an error and
+/// does what the C calls do: ownership (move-only, the destructor destroys,
+/// a moved-from world is empty), every refusal an `mpca::error` with the
+/// status and its message, a scene hashing and exporting equal through the
+/// wrapper and through mpca.h, and step_parallel with a lambda, a
+/// std::function on two threads, misused tasks and a host that throws.
+#[test]
+fn the_cpp_wrapper_does_what_the_c_calls_do() {
+    let run = cpp_wrapper();
+    for group in ["ownership", "errors", "same as C", "parallel"] {
+        assert!(run.values("cpp: ").contains(&group), "cpp_wrapper did not finish `{group}`:\n{}", run.stdout);
+    }
+    let (checks, failed) = run.value("cpp checks: ").split_once(" failed: ").expect("N failed: M");
+    let checks: u32 = checks.parse().expect("a count");
+    println!("cpp_wrapper: {checks} checks");
+    assert_eq!(failed, "0", "{}", run.stdout);
+    assert!(checks >= MIN_CPP_CHECKS, "only {checks} checks ran, at least {MIN_CPP_CHECKS} expected");
+    run.assert_success();
 }
 
 // --- The parallel step (M11) ----------------------------------------------
