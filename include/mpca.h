@@ -15,9 +15,13 @@
  * Buffers: an export that fills a caller's buffer and writes a count takes
  * NULL with capacity 0 as a size query (the count, MPCA_STATUS_OK).
  *
- * Link: cc app.c -Iinclude -Ltarget/release -lmpca -lm
- * (the shared library also needs -lpthread -ldl on older glibc, and the
- * directory of libmpca.so on the loader path at run time).
+ * Link, once installed (scripts/install.sh --prefix DIR):
+ *   cc app.c $(pkg-config --cflags --libs mpca)
+ * or from the build folder: cc app.c -Iinclude -Ltarget/release -lmpca;
+ * the program then loads libmpca.so.0 (the SONAME), which an install
+ * provides. A static link adds the Libs.private of mpca.pc
+ * (pkg-config --static --libs mpca).
+ * C++: mpca.hpp wraps this header.
  */
 
 #ifndef MPCA_H
