@@ -789,26 +789,80 @@ fn a_world_rebuilds_from_its_own_export() {
 }
 
 /// The README's C example (its first ```c block), compiled with the same
-/// strict flags, linked as the README says (`-lmpca -lm`, here statically by
-/// path) and run. Expected: exit 0, and all 64 particles it adds still there
+/// strict flags, linked as the README's static line says (`libmpca.a -lm
+/// -lpthread -ldl`) and run. Expected: exit 0, and all 64 particles it adds still there
 /// after its 100 steps, falling (negative y momentum).
 #[test]
 fn the_readme_c_example_builds_and_runs() {
+    let line = readme_program("c", false);
+    assert!(line.starts_with("64 particles after 100 steps, momentum y -"), "{line}");
+}
+
+/// The same program compiled as C++11 (`-std=c++11 -Wall -Wextra
+/// -Wpedantic -Werror`): the README says it compiles as both.
+#[test]
+fn the_readme_c_example_builds_and_runs_as_cpp11() {
+    let line = readme_program("c", true);
+    assert!(line.starts_with("64 particles after 100 steps, momentum y -"), "{line}");
+}
+
+/// The README's C++ example (its ```cpp block), compiled as C++11 with the
+/// strict flags against `include/mpca.hpp` and run: its 64 particles, the
+/// first one in the floor row.
+#[test]
+fn the_readme_cpp_example_builds_and_runs() {
+    let line = readme_program("cpp", true);
+    assert!(line.starts_with("64 particles, the first at ("), "{line}");
+}
+
+/// The README's other C blocks (fragments with no `main`) compile as C99
+/// and as C++11 with the strict flags.
+#[test]
+fn the_readme_c_fragments_compile_as_c99_and_cpp11() {
+    let blocks = readme_blocks("c");
+    assert!(blocks.len() >= 2, "README.md has no C fragment beyond its program");
+    for (i, block) in blocks.iter().enumerate().skip(1) {
+        for cpp in [false, true] {
+            let src = out_dir().join(format!("readme_fragment_{i}.{}", if cpp { "cpp" } else { "c" }));
+            std::fs::write(&src, block).unwrap();
+            let mut cmd = compiler(cpp, false);
+            let out = cmd.arg("-fsyntax-only").arg(&src).output().expect("the compiler runs");
+            assert!(out.status.success(), "{}\n{}", command_line(&cmd), String::from_utf8_lossy(&out.stderr));
+        }
+    }
+}
+
+/// The contents of every ```LANG block of README.md, in order.
+fn readme_blocks(lang: &str) -> Vec<String> {
     let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
-    let start = readme.find("```c\n").expect("README.md has a ```c block") + "```c\n".len();
-    let end = start + readme[start..].find("```").expect("the ```c block ends");
-    let src = out_dir().join("readme_example.c");
-    std::fs::write(&src, &readme[start..end]).unwrap();
-    let exe = out_dir().join("readme_example");
-    let mut cmd = compiler(false, false);
+    let fence = format!("```{lang}\n");
+    let mut blocks = Vec::new();
+    let mut rest = readme.as_str();
+    while let Some(at) = rest.find(&fence) {
+        let body = &rest[at + fence.len()..];
+        let end = body.find("```").unwrap_or_else(|| panic!("a ```{lang} block of README.md never ends"));
+        blocks.push(body[..end].to_string());
+        rest = &body[end + 3..];
+    }
+    blocks
+}
+
+/// The first ```LANG block of README.md compiled (as C++11 when `cpp`),
+/// linked with `libmpca.a` and run; its first line of output.
+fn readme_program(lang: &str, cpp: bool) -> String {
+    let source = readme_blocks(lang).into_iter().next().unwrap_or_else(|| panic!("README.md has no ```{lang} block"));
+    let name = format!("readme_{lang}_as_{}", if cpp { "cpp" } else { "c" });
+    let src = out_dir().join(format!("{name}.{}", if cpp { "cpp" } else { "c" }));
+    std::fs::write(&src, source).unwrap();
+    let exe = out_dir().join(&name);
+    let mut cmd = compiler(cpp, false);
     cmd.arg("-o").arg(&exe).arg(&src).arg(library().join("libmpca.a")).args(["-lm", "-lpthread", "-ldl"]);
-    let out = cmd.output().expect("the C compiler runs");
+    let out = cmd.output().expect("the compiler runs");
     assert!(out.status.success(), "{}\n{}", command_line(&cmd), String::from_utf8_lossy(&out.stderr));
     let out = Command::new(&exe).env_remove("LD_LIBRARY_PATH").output().expect("the example runs");
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success(), "exit {}: {stdout}{}", out.status, String::from_utf8_lossy(&out.stderr));
-    let line = stdout.lines().next().unwrap_or_default();
-    assert!(line.starts_with("64 particles after 100 steps, momentum y -"), "{line}");
+    stdout.lines().next().unwrap_or_default().to_string()
 }
 
 // --- The C++ wrapper ------------------------------------------------------------
