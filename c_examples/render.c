@@ -581,6 +581,7 @@ static void usage(const scene *s, FILE *f) {
             "  --out DIR   output folder, created if missing (default " DEFAULT_OUT ")\n"
             "  --name S    file name prefix (default %s)\n"
             "  --threads N step in tasks on N threads, 1 to 16 (M11; default: mpca_world_step)\n"
+            "  --version   print the program's and libmpca's versions and exit\n"
             "  --help      print this and exit\n",
             s->name, s->title, s->about, (unsigned)d->size, (unsigned long long)d->steps,
             (unsigned long long)d->seed, (unsigned long long)d->every, (unsigned)d->tiles, (unsigned)d->px,
@@ -603,6 +604,10 @@ static int parse_options(const scene *s, scene_opts *o, int argc, char **argv) {
         const char *a = argv[i];
         if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
             usage(s, stdout);
+            return 0;
+        }
+        if (strcmp(a, "--version") == 0) {
+            printf("%s (libmpca %s)\n", s->name, mpca_version());
             return 0;
         }
         const char *value = i + 1 < argc ? argv[i + 1] : NULL;

@@ -12,9 +12,16 @@
  * returns MPCA_STATUS_PANIC instead of unwinding into C; firmware builds
  * (no std) halt on a panic. No input is meant to cause one.
  *
- * Link: cc app.c -Iinclude -Ltarget/release -lmpca -lm
- * (the shared library also needs -lpthread -ldl on older glibc, and the
- * directory of libmpca.so on the loader path at run time).
+ * Buffers: an export that fills a caller's buffer and writes a count takes
+ * NULL with capacity 0 as a size query (the count, MPCA_STATUS_OK).
+ *
+ * Link, once installed (scripts/install.sh --prefix DIR):
+ *   cc app.c $(pkg-config --cflags --libs mpca)
+ * or from the build folder: cc app.c -Iinclude -Ltarget/release -lmpca;
+ * the program then loads libmpca.so.0 (the SONAME), which an install
+ * provides. A static link adds the Libs.private of mpca.pc
+ * (pkg-config --static --libs mpca).
+ * C++: mpca.hpp wraps this header.
  */
 
 #ifndef MPCA_H
@@ -1053,7 +1060,15 @@ mpca_status mpca_world_particle_count(const struct mpca_world *world, size_t *ou
 /**
  * Particle positions as 3 floats each (cell centres: x + 0.5, y + 0.5,
  * z + 0.5; z is 0.5 in 2D), ready for a vertex buffer. `capacity` counts
- * particles (the buffer holds 3 * capacity floats).
+ * particles (the buffer holds 3 * capacity floats); the particle count
+ * goes to `out_count`.
+ *
+ * Size query: `out` NULL with `capacity` 0 writes the count and returns
+ * `MPCA_STATUS_OK`; call again with a buffer that large. A buffer too
+ * small (capacity 0 included) returns `MPCA_STATUS_OUTPUT_TOO_SMALL`,
+ * writing the count and nothing else; NULL with a capacity above 0 is
+ * `MPCA_STATUS_NULL_POINTER`. The same holds for every export with an
+ * `out_count`.
  */
 mpca_status mpca_world_export_positions(const struct mpca_world *world,
                                         float *out,
@@ -1062,7 +1077,7 @@ mpca_status mpca_world_export_positions(const struct mpca_world *world,
 
 /**
  * Particle velocities as 3 floats each, in the order of
- * mpca_world_export_positions.
+ * mpca_world_export_positions; buffer, count and size query as there.
  */
 mpca_status mpca_world_export_velocities(const struct mpca_world *world,
                                          float *out,
@@ -1071,7 +1086,7 @@ mpca_status mpca_world_export_velocities(const struct mpca_world *world,
 
 /**
  * Particle masses, one float each, in the order of
- * mpca_world_export_positions.
+ * mpca_world_export_positions; buffer, count and size query as there.
  */
 mpca_status mpca_world_export_masses(const struct mpca_world *world,
                                      float *out,

@@ -135,7 +135,7 @@ if [ "$docs" -eq 1 ]; then
         echo "the smoke scene a second time, for 480 steps) and prints where the images"
         echo "are: \`out/scenes/\`. Each program also runs alone, e.g."
         echo "\`target/c_examples/water --size 32 --steps 200 --every 20 --out /tmp/w\`;"
-        echo "\`--help\` lists its options (\`--size --steps --seed --every --tiles --px --out --name\`)."
+        echo "\`--help\` lists its options (\`--size --steps --seed --every --tiles --px --out --name --threads --version\`)."
         echo
         for run in "${runs[@]}"; do
             echo "**$(section "$run")**: $(caption "$run")"

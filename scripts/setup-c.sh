@@ -1,12 +1,14 @@
 #!/usr/bin/env bash
-# Makes sure the C side can build: a C compiler, make, and the OSMesa and
-# libpng headers the rendered scenes (c_examples/) use; installs what is
-# missing (scripts/install-missing.sh).
+# Makes sure the C side can build: a C and a C++ compiler, make, and the
+# OSMesa and libpng headers the rendered scenes (c_examples/) use; installs
+# what is missing (scripts/install-missing.sh).
 set -euo pipefail
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 cc=${CC:-cc}
+cxx=${CXX:-c++}
 missing=()
 command -v make >/dev/null 2>&1 || missing+=(make)
+command -v "$cxx" >/dev/null 2>&1 || missing+=(g++)
 if ! command -v "$cc" >/dev/null 2>&1; then
     missing+=(gcc libc6-dev libosmesa6-dev libpng-dev)
 else
@@ -17,5 +19,5 @@ fi
 if [ ${#missing[@]} -gt 0 ]; then
     "$here/install-missing.sh" "${missing[@]}"
 else
-    echo "make, $cc, OSMesa and libpng headers: present"
+    echo "make, $cc, $cxx, OSMesa and libpng headers: present"
 fi

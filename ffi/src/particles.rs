@@ -119,7 +119,9 @@ pub unsafe extern "C" fn mpca_world_particle_count(world: *const mpca_world, out
 
 /// Writes `per` floats of each particle, in cell order, into `out`, which
 /// has room for `capacity` particles; the particle count goes to
-/// `out_count`. Too small a buffer writes nothing but the count.
+/// `out_count`. Too small a buffer writes nothing but the count. `out`
+/// NULL with `capacity` 0 asks for the count alone (the size query every
+/// export of the header answers); NULL with room claimed is refused.
 unsafe fn export(
     world: *const mpca_world,
     out: *mut f32,
@@ -131,11 +133,14 @@ unsafe fn export(
     guard(|| {
         let w = unsafe { world_ref(world)? };
         let count = unsafe { write(out_count)? };
-        if out.is_null() {
+        if out.is_null() && capacity != 0 {
             return Err(mpca_status::NullPointer);
         }
         let n = w.particle_count() as usize;
         *count = n;
+        if out.is_null() {
+            return Ok(()); // the size query
+        }
         if capacity < n {
             return Err(mpca_status::OutputTooSmall);
         }
@@ -150,7 +155,15 @@ unsafe fn export(
 
 /// Particle positions as 3 floats each (cell centres: x + 0.5, y + 0.5,
 /// z + 0.5; z is 0.5 in 2D), ready for a vertex buffer. `capacity` counts
-/// particles (the buffer holds 3 * capacity floats).
+/// particles (the buffer holds 3 * capacity floats); the particle count
+/// goes to `out_count`.
+///
+/// Size query: `out` NULL with `capacity` 0 writes the count and returns
+/// `MPCA_STATUS_OK`; call again with a buffer that large. A buffer too
+/// small (capacity 0 included) returns `MPCA_STATUS_OUTPUT_TOO_SMALL`,
+/// writing the count and nothing else; NULL with a capacity above 0 is
+/// `MPCA_STATUS_NULL_POINTER`. The same holds for every export with an
+/// `out_count`.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_world_export_positions(
     world: *const mpca_world,
@@ -162,7 +175,7 @@ pub unsafe extern "C" fn mpca_world_export_positions(
 }
 
 /// Particle velocities as 3 floats each, in the order of
-/// mpca_world_export_positions.
+/// mpca_world_export_positions; buffer, count and size query as there.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_world_export_velocities(
     world: *const mpca_world,
@@ -174,7 +187,7 @@ pub unsafe extern "C" fn mpca_world_export_velocities(
 }
 
 /// Particle masses, one float each, in the order of
-/// mpca_world_export_positions.
+/// mpca_world_export_positions; buffer, count and size query as there.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_world_export_masses(
     world: *const mpca_world,

@@ -1095,6 +1095,35 @@ static void output_cases(void) {
         CHECK(written == 0);
     }
 
+    /* NULL with capacity 0 is not an error but the size query: the count,
+     * MPCA_STATUS_OK, and no world changed. With room claimed (capacity
+     * 1, below the count, or the whole count) NULL is refused. */
+    set_context("size query: NULL with capacity 0");
+    uint64_t before = fingerprint();
+    size_t count = SENTINEL_SIZE;
+    CHECK_OK(mpca_world_export_positions(full2, NULL, 0, &count));
+    CHECK(count == n);
+    count = SENTINEL_SIZE;
+    CHECK_OK(mpca_world_export_velocities(full2, NULL, 0, &count));
+    CHECK(count == n);
+    count = SENTINEL_SIZE;
+    CHECK_OK(mpca_world_export_masses(full2, NULL, 0, &count));
+    CHECK(count == n);
+    CHECK(fingerprint() == before);
+    const size_t claimed[2] = {1, n};
+    for (at = 0; at < 2; at++) {
+        set_context("NULL with capacity %u of %u", (unsigned)claimed[at], (unsigned)n);
+        count = SENTINEL_SIZE;
+        REFUSED(MPCA_STATUS_NULL_POINTER, mpca_world_export_positions(full2, NULL, claimed[at], &count));
+        REFUSED(MPCA_STATUS_NULL_POINTER, mpca_world_export_velocities(full2, NULL, claimed[at], &count));
+        REFUSED(MPCA_STATUS_NULL_POINTER, mpca_world_export_masses(full2, NULL, claimed[at], &count));
+        CHECK(count == SENTINEL_SIZE);
+    }
+    set_context("size query without a count");
+    REFUSED(MPCA_STATUS_NULL_POINTER, mpca_world_export_positions(full2, NULL, 0, NULL));
+    REFUSED(MPCA_STATUS_NULL_POINTER, mpca_world_export_velocities(full2, NULL, 0, NULL));
+    REFUSED(MPCA_STATUS_NULL_POINTER, mpca_world_export_masses(full2, NULL, 0, NULL));
+
     /* Resolutions: zero, more bins than cells, a z bin count other than 1
      * in 2D; and lengths that are not the product of the resolution. */
     const uint32_t bad2[][3] = {{0, 16, 1}, {16, 0, 1}, {16, 16, 0}, {17, 16, 1}, {16, 17, 1}, {16, 16, 2}, {1, 1, 2}};

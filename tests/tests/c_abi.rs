@@ -17,6 +17,8 @@
 //!   change nothing, the region counters; an image written from C is loaded
 //!   here through the Rust API.
 //! - `header_only.c`: `include/mpca.h` alone, as C99 and as C++11.
+//! - `cpp_wrapper.cpp` (linked statically): `include/mpca.hpp`, the C++11
+//!   wrapper, against the C functions it wraps.
 //!
 //! With `MPCA_C_SANITIZE=1` every program is built with AddressSanitizer
 //! (LeakSanitizer included) and UndefinedBehaviorSanitizer, into a separate
@@ -38,6 +40,9 @@ use mpca::{Boundary, Collisions, Description, Drift, Emitter, Method, Quantizati
 /// Error cases `errors.c` must try. It tries 1,795 today; the margin is
 /// for cases merged or reworded, not for groups dropped.
 const MIN_ERROR_CASES: u64 = 1700;
+
+/// Checks `cpp_wrapper.cpp` must make: 213 today (a THROWS is three).
+const MIN_CPP_CHECKS: u32 = 200;
 
 const SANITIZE_FLAGS: [&str; 3] = ["-fsanitize=address,undefined", "-fno-omit-frame-pointer", "-fno-sanitize-recover=all"];
 
@@ -258,6 +263,27 @@ fn snapshots() -> &'static Run {
     RUN.get_or_init(|| run(build("snapshots", &["snapshots.c", "check.c"], Link::Shared), ""))
 }
 
+/// `cpp_wrapper.cpp`, compiled as C++11 with the same strict flags and
+/// linked with `libmpca.a`, run once per test process.
+fn cpp_wrapper() -> &'static Run {
+    static RUN: OnceLock<Run> = OnceLock::new();
+    RUN.get_or_init(|| {
+        let exe = out_dir().join("cpp_wrapper");
+        let mut cmd = compiler(true, false);
+        cmd.arg("-pthread").arg("-o").arg(&exe).arg(root().join("tests/c/cpp_wrapper.cpp"));
+        cmd.arg(library().join("libmpca.a")).args(["-lm", "-lpthread", "-ldl"]);
+        let out = cmd.output().expect("the C++ compiler runs");
+        assert!(
+            out.status.success(),
+            "compiling cpp_wrapper failed:\n{}\n{}{}",
+            command_line(&cmd),
+            String::from_utf8_lossy(&out.stdout),
+            String::from_utf8_lossy(&out.stderr)
+        );
+        run(exe, "")
+    })
+}
+
 /// `include/mpca.h` without its comments.
 fn header_code() -> String {
     let text = std::fs::read_to_string(root().join("include/mpca.h")).expect("include/mpca.h");
@@ -326,6 +352,7 @@ impl Elf {
     const SHT_DYNSYM: u32 = 11;
     const SHT_DYNAMIC: u32 = 6;
     const DT_NEEDED: u64 = 1;
+    const DT_SONAME: u64 = 14;
 
     fn read(path: &Path) -> Elf {
         let data = std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
@@ -359,11 +386,21 @@ impl Elf {
 
     /// The DT_NEEDED entries of the dynamic section.
     fn needed(&self) -> Vec<String> {
+        self.dynamic_strings(Self::DT_NEEDED)
+    }
+
+    /// The DT_SONAME entry of the dynamic section, if any.
+    fn soname(&self) -> Option<String> {
+        self.dynamic_strings(Self::DT_SONAME).into_iter().next()
+    }
+
+    /// The strings of the dynamic section's entries tagged `tag`.
+    fn dynamic_strings(&self, tag: u64) -> Vec<String> {
         let sections = self.sections();
         let mut names = Vec::new();
         for s in sections.iter().filter(|s| s.kind == Self::SHT_DYNAMIC) {
             for e in (s.offset..s.offset + s.size).step_by(16) {
-                if self.uint(e, 8) == Self::DT_NEEDED {
+                if self.uint(e, 8) == tag {
                     names.push(self.string(&sections[s.link], self.uint(e + 8, 8) as usize));
                 }
             }
@@ -420,7 +457,17 @@ fn static_and_shared_programs_link_the_library_they_should() {
     assert!(!needed.iter().any(is_mpca), "errors (linked with libmpca.a) needs {needed:?}");
     assert!(needed.iter().any(|n| n.starts_with("libc.so")), "the ELF parse found no libc in {needed:?}");
     let needed = Elf::read(&scenes().exe).needed();
-    assert!(needed.iter().any(is_mpca), "scenes (linked with -lmpca) needs only {needed:?}");
+    // By the SONAME, not the file name it was linked from.
+    assert!(needed.iter().any(|n| n == clib::soname()), "scenes (linked with -lmpca) needs only {needed:?}");
+}
+
+/// libmpca.so as cargo builds it carries the SONAME `libmpca.so.MAJOR`
+/// (ffi/build.rs), the name scripts/install.sh gives its link, so programs
+/// keep loading any later library of the same major version.
+#[test]
+fn the_shared_library_carries_its_soname() {
+    let soname = Elf::read(&library().join("libmpca.so")).soname();
+    assert_eq!(soname.as_deref(), Some(clib::soname()), "the SONAME of libmpca.so");
 }
 
 #[test]
@@ -662,7 +709,7 @@ fn exports_from_c_agree_with_the_cells_and_the_density() {
 
 #[test]
 fn sanitizers_are_linked_in_exactly_when_asked() {
-    for run in [errors(), scenes(), reuse(), edges(), parallel(), snapshots()] {
+    for run in [errors(), scenes(), reuse(), edges(), parallel(), snapshots(), cpp_wrapper()] {
         let printed = run.value("sanitizer: ");
         let needed = Elf::read(&run.exe).needed();
         let asan = needed.iter().any(|n| n.starts_with("libasan.so"));
@@ -751,26 +798,102 @@ fn a_world_rebuilds_from_its_own_export() {
 }
 
 /// The README's C example (its first ```c block), compiled with the same
-/// strict flags, linked as the README says (`-lmpca -lm`, here statically by
-/// path) and run. Expected: exit 0, and all 64 particles it adds still there
+/// strict flags, linked as the README's static line says (`libmpca.a -lm
+/// -lpthread -ldl`) and run. Expected: exit 0, and all 64 particles it adds still there
 /// after its 100 steps, falling (negative y momentum).
 #[test]
 fn the_readme_c_example_builds_and_runs() {
+    let line = readme_program("c", false);
+    assert!(line.starts_with("64 particles after 100 steps, momentum y -"), "{line}");
+}
+
+/// The same program compiled as C++11 (`-std=c++11 -Wall -Wextra
+/// -Wpedantic -Werror`): the README says it compiles as both.
+#[test]
+fn the_readme_c_example_builds_and_runs_as_cpp11() {
+    let line = readme_program("c", true);
+    assert!(line.starts_with("64 particles after 100 steps, momentum y -"), "{line}");
+}
+
+/// The README's C++ example (its ```cpp block), compiled as C++11 with the
+/// strict flags against `include/mpca.hpp` and run: its 64 particles, the
+/// first one in the floor row.
+#[test]
+fn the_readme_cpp_example_builds_and_runs() {
+    let line = readme_program("cpp", true);
+    assert!(line.starts_with("64 particles, the first at ("), "{line}");
+}
+
+/// The README's other C blocks (fragments with no `main`) compile as C99
+/// and as C++11 with the strict flags.
+#[test]
+fn the_readme_c_fragments_compile_as_c99_and_cpp11() {
+    let blocks = readme_blocks("c");
+    assert!(blocks.len() >= 2, "README.md has no C fragment beyond its program");
+    for (i, block) in blocks.iter().enumerate().skip(1) {
+        for cpp in [false, true] {
+            let src = out_dir().join(format!("readme_fragment_{i}.{}", if cpp { "cpp" } else { "c" }));
+            std::fs::write(&src, block).unwrap();
+            let mut cmd = compiler(cpp, false);
+            let out = cmd.arg("-fsyntax-only").arg(&src).output().expect("the compiler runs");
+            assert!(out.status.success(), "{}\n{}", command_line(&cmd), String::from_utf8_lossy(&out.stderr));
+        }
+    }
+}
+
+/// The contents of every ```LANG block of README.md, in order.
+fn readme_blocks(lang: &str) -> Vec<String> {
     let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
-    let start = readme.find("```c\n").expect("README.md has a ```c block") + "```c\n".len();
-    let end = start + readme[start..].find("```").expect("the ```c block ends");
-    let src = out_dir().join("readme_example.c");
-    std::fs::write(&src, &readme[start..end]).unwrap();
-    let exe = out_dir().join("readme_example");
-    let mut cmd = compiler(false, false);
+    let fence = format!("```{lang}\n");
+    let mut blocks = Vec::new();
+    let mut rest = readme.as_str();
+    while let Some(at) = rest.find(&fence) {
+        let body = &rest[at + fence.len()..];
+        let end = body.find("```").unwrap_or_else(|| panic!("a ```{lang} block of README.md never ends"));
+        blocks.push(body[..end].to_string());
+        rest = &body[end + 3..];
+    }
+    blocks
+}
+
+/// The first ```LANG block of README.md compiled (as C++11 when `cpp`),
+/// linked with `libmpca.a` and run; its first line of output.
+fn readme_program(lang: &str, cpp: bool) -> String {
+    let source = readme_blocks(lang).into_iter().next().unwrap_or_else(|| panic!("README.md has no ```{lang} block"));
+    let name = format!("readme_{lang}_as_{}", if cpp { "cpp" } else { "c" });
+    let src = out_dir().join(format!("{name}.{}", if cpp { "cpp" } else { "c" }));
+    std::fs::write(&src, source).unwrap();
+    let exe = out_dir().join(&name);
+    let mut cmd = compiler(cpp, false);
     cmd.arg("-o").arg(&exe).arg(&src).arg(library().join("libmpca.a")).args(["-lm", "-lpthread", "-ldl"]);
-    let out = cmd.output().expect("the C compiler runs");
+    let out = cmd.output().expect("the compiler runs");
     assert!(out.status.success(), "{}\n{}", command_line(&cmd), String::from_utf8_lossy(&out.stderr));
     let out = Command::new(&exe).env_remove("LD_LIBRARY_PATH").output().expect("the example runs");
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success(), "exit {}: {stdout}{}", out.status, String::from_utf8_lossy(&out.stderr));
-    let line = stdout.lines().next().unwrap_or_default();
-    assert!(line.starts_with("64 particles after 100 steps, momentum y -"), "{line}");
+    stdout.lines().next().unwrap_or_default().to_string()
+}
+
+// --- The C++ wrapper ------------------------------------------------------------
+
+/// `include/mpca.hpp` compiles as C++11 with every warning an error and
+/// does what the C calls do: ownership (move-only, the destructor destroys,
+/// a moved-from world is empty), every refusal an `mpca::error` with the
+/// status and its message, a scene hashing and exporting equal through the
+/// wrapper and through mpca.h, and step_parallel with a lambda, a
+/// std::function on two threads, misused tasks and a host that throws.
+#[test]
+fn the_cpp_wrapper_does_what_the_c_calls_do() {
+    let run = cpp_wrapper();
+    for group in ["ownership", "errors", "same as C", "parallel"] {
+        assert!(run.values("cpp: ").contains(&group), "cpp_wrapper did not finish `{group}`:\n{}", run.stdout);
+    }
+    let (checks, failed) = run.value("cpp checks: ").split_once(" failed: ").expect("N failed: M");
+    let checks: u32 = checks.parse().expect("a count");
+    println!("cpp_wrapper: {checks} checks");
+    assert_eq!(failed, "0", "{}", run.stdout);
+    assert!(checks >= MIN_CPP_CHECKS, "only {checks} checks ran, at least {MIN_CPP_CHECKS} expected");
+    run.assert_success();
 }
 
 // --- The parallel step (M11) ----------------------------------------------

@@ -10,9 +10,11 @@
 //! - Each program runs a few steps at the paper's size, and its world's
 //!   hash must equal that of the same scene built by `tests/src/scenes.rs`:
 //!   the C scenes are the Rust scenes, placement and seeds included.
+//! - `threads` and `cpp_example` (the C++ wrapper), which draw nothing,
+//!   end equal on any thread count; every program answers `--version`.
 //!
-//! Needs `make`, a C compiler and the OSMesa and libpng headers; the test
-//! fails, naming the packages, when they are missing.
+//! Needs `make`, a C and a C++ compiler and the OSMesa and libpng headers;
+//! the test fails, naming the packages, when they are missing.
 #![cfg(target_os = "linux")]
 
 mod clib;
@@ -37,6 +39,18 @@ fn c_compiler() -> cc::Tool {
         .target(env!("MPCA_TEST_TARGET"))
         .host(env!("MPCA_TEST_HOST"))
         .opt_level(2)
+        .get_compiler()
+}
+
+/// The C++ compiler cc picks for this target (for cpp_example.cpp).
+fn cpp_compiler() -> cc::Tool {
+    cc::Build::new()
+        .cargo_metadata(false)
+        .cargo_warnings(false)
+        .target(env!("MPCA_TEST_TARGET"))
+        .host(env!("MPCA_TEST_HOST"))
+        .opt_level(2)
+        .cpp(true)
         .get_compiler()
 }
 
@@ -79,6 +93,7 @@ fn programs() -> &'static Path {
             .arg(format!("MPCA_LIB={}", lib.display()))
             .arg(format!("BUILD={}", dir.display()))
             .arg(format!("CC={}", cc.path().display()))
+            .arg(format!("CXX={}", cpp_compiler().path().display()))
             .output()
             .expect("make runs");
         assert!(
@@ -352,7 +367,7 @@ fn every_program_documents_and_checks_its_options() {
     for scene in ["aggregation", "cluster", "smoke", "water"] {
         let help = run(scene, &["--help"]);
         for option in
-            ["--size N", "--steps N", "--seed N", "--every N", "--tiles N", "--px N", "--out DIR", "--name S", "--threads N"]
+            ["--size N", "--steps N", "--seed N", "--every N", "--tiles N", "--px N", "--out DIR", "--name S", "--threads N", "--version"]
         {
             assert!(help.contains(option), "{scene} --help does not mention {option}:\n{help}");
         }
@@ -374,4 +389,39 @@ fn the_threads_example_equals_the_serial_step() {
     }
     let version = run("threads", &["--version"]);
     assert!(version.starts_with("threads (libmpca "), "{version}");
+}
+
+/// Every program of c_examples/ (not pngstat, a tool of these tests)
+/// answers `--version` with its name and the version of the libmpca it
+/// was linked with, and does nothing else.
+#[test]
+fn every_example_program_prints_its_version() {
+    let expected = env!("CARGO_PKG_VERSION"); // the workspace's, as mpca-ffi's
+    for program in ["aggregation", "cluster", "smoke", "water", "threads", "cpp_example"] {
+        let out = run(program, &["--version"]);
+        assert_eq!(out, format!("{program} (libmpca {expected})\n"), "{program} --version");
+    }
+}
+
+/// `c_examples/cpp_example.cpp`, the hourglass through include/mpca.hpp:
+/// it pours three grains a step, prints the box as text, and ends with
+/// the same world on 1 and on 3 threads (its step_parallel host).
+#[test]
+fn the_cpp_example_pours_the_same_hourglass_on_any_thread_count() {
+    let mut finals = Vec::new();
+    for threads in ["1", "3"] {
+        let out = run("cpp_example", &["--steps", "120", "--every", "60", "--threads", threads]);
+        let pictures = out.lines().filter(|l| l.starts_with('|') && l.ends_with('|') && l.len() == 66).count();
+        assert_eq!(pictures, 2 * 32, "two pictures of 32 rows of 64 bins:\n{out}");
+        let last = out.lines().last().unwrap_or_default().to_string();
+        let f = fields(&last);
+        let emitted: u64 = number(&f, "emitted", &last);
+        let particles: u64 = number(&f, "particles", &last);
+        assert!(emitted == 3 * 120 && particles == emitted, "a rate of 3 a step for 120 steps, in a closed box: {last}");
+        assert_eq!(f.get("threads"), Some(&threads), "{last}");
+        finals.push(last.replace(&format!("threads={threads} "), ""));
+    }
+    assert_eq!(finals[0], finals[1], "1 thread against 3");
+    let bad = Command::new(programs().join("cpp_example")).args(["--threads", "0"]).output().expect("runs");
+    assert_eq!(bad.status.code(), Some(2), "--threads 0 should be refused");
 }

@@ -38,7 +38,22 @@ pub fn library() -> &'static Path {
         for lib in ["libmpca.a", "libmpca.so"] {
             assert!(dir.join(lib).is_file(), "{lib} missing from {}", dir.display());
         }
+        // Programs linked with libmpca.so record its SONAME, libmpca.so.MAJOR
+        // (ffi/build.rs), and the loader looks for that name: an installed
+        // library has the link (scripts/install.sh); here it is made beside
+        // the build.
+        let soname = dir.join(soname());
+        #[cfg(unix)]
+        if let Err(e) = std::os::unix::fs::symlink("libmpca.so", &soname) {
+            assert_eq!(e.kind(), std::io::ErrorKind::AlreadyExists, "linking {}: {e}", soname.display());
+        }
         dir
     })
 }
 
+
+/// The SONAME ffi/build.rs gives libmpca.so: `libmpca.so.MAJOR`, the major
+/// version being the workspace's (mpca-ffi's and this crate's).
+pub fn soname() -> &'static str {
+    concat!("libmpca.so.", env!("CARGO_PKG_VERSION_MAJOR"))
+}

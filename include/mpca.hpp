@@ -1,0 +1,382 @@
+/*
+ * mpca.hpp: libmpca for C++11, header-only, over the C ABI of mpca.h.
+ *
+ *   mpca::world w(mpca::desc_2d(64, 64));      // mpca_world_create
+ *   w.add_particle({10, 60, 0}, {0.3f, 0.0f, 0.0f});
+ *   w.step(100);
+ *   std::vector<float> xyz = w.positions();    // 3 floats a particle
+ *                                              // ~world: mpca_world_destroy
+ *
+ * - mpca::world owns one world made by mpca_world_create (hosted builds of
+ *   the library) and destroys it in its destructor. It moves and does not
+ *   copy; a moved-from world is empty, and calls on it throw the status
+ *   MPCA_STATUS_NULL_POINTER.
+ * - Every refusal throws mpca::error, which carries the mpca_status and
+ *   mpca_status_message's text as what(). The world is unchanged then, as
+ *   the C ABI promises.
+ * - Exports come back as std::vector, or go into the caller's buffer
+ *   (export_positions and its twins, for a mapped vertex buffer).
+ * - step_parallel takes any callable host, a lambda or a std::function,
+ *   which runs one step's tasks on the caller's threads (M11).
+ *
+ * Each method is one call of the C function of the same name; get() gives
+ * the mpca_world * for everything else in mpca.h.
+ */
+#ifndef MPCA_HPP
+#define MPCA_HPP
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <exception>
+#include <limits>
+#include <memory>
+#include <stdexcept>
+#include <type_traits>
+#include <vector>
+
+#include "mpca.h"
+
+namespace mpca {
+
+/** A call the library refused: its status and that status's message. */
+class error : public std::runtime_error {
+public:
+    explicit error(mpca_status status) : std::runtime_error(mpca_status_message(status)), status_(status) {}
+
+    /** The status the C function returned. */
+    mpca_status status() const noexcept { return status_; }
+
+private:
+    mpca_status status_;
+};
+
+/** Throws mpca::error unless `status` is MPCA_STATUS_OK. */
+inline void check(mpca_status status) {
+    if (status != MPCA_STATUS_OK) {
+        throw error(status);
+    }
+}
+
+/** The library's version, "MAJOR.MINOR.PATCH". */
+inline const char *version() noexcept { return mpca_version(); }
+
+/** Cell coordinates (the third 0 in 2D). */
+typedef std::array<std::uint32_t, 3> cell_pos;
+/** A vector: a velocity, a force, a point or a normal (the third 0 in 2D). */
+typedef std::array<float, 3> vec3;
+
+/** mpca_desc_defaults for a world of nx x ny cells. */
+inline mpca_desc desc_2d(std::uint32_t nx, std::uint32_t ny) {
+    mpca_desc d;
+    check(mpca_desc_defaults(&d, 2, nx, ny, 0));
+    return d;
+}
+
+/** mpca_desc_defaults for a world of nx x ny x nz cells. */
+inline mpca_desc desc_3d(std::uint32_t nx, std::uint32_t ny, std::uint32_t nz) {
+    mpca_desc d;
+    check(mpca_desc_defaults(&d, 3, nx, ny, nz));
+    return d;
+}
+
+/**
+ * The tasks of one step of world::step_parallel, as the host receives
+ * them: run each index in [0, count()) once, in any order, on any thread;
+ * distinct indices may run at the same time.
+ */
+class tasks {
+public:
+    tasks(mpca_world *world, std::uint64_t ticket, std::uint32_t count) noexcept
+        : world_(world), ticket_(ticket), count_(count) {}
+
+    /** How many tasks this step has. */
+    std::uint32_t count() const noexcept { return count_; }
+
+    /** Runs task `index` (mpca_world_step_task); throws mpca::error when
+     * refused: run already, index not below count(), or the step is over. */
+    void operator()(std::uint32_t index) const { check(run(index)); }
+
+    /** Runs task `index`, returning the status instead of throwing. */
+    mpca_status run(std::uint32_t index) const noexcept { return mpca_world_step_task(world_, ticket_, index); }
+
+private:
+    mpca_world *world_;
+    std::uint64_t ticket_;
+    std::uint32_t count_;
+};
+
+namespace detail {
+
+/** What mpca_world_step_parallel hands back to run_tasks: the host, how to
+ * call it, and an exception it threw, kept until the C call returns. */
+struct host_call {
+    void *host;
+    void (*invoke)(void *host, const tasks &t);
+    std::exception_ptr thrown;
+};
+
+template <class Host>
+void invoke_host(void *host, const tasks &t) {
+    (*static_cast<Host *>(host))(t);
+}
+
+/* The mpca_run_tasks of every step_parallel. An exception must not unwind
+ * through the library, so it is caught here and thrown again once
+ * mpca_world_step_parallel has returned. */
+extern "C" inline void mpca_hpp_run_tasks(mpca_world *world, std::uint64_t ticket, std::uint32_t count,
+                                          void *user_data) noexcept {
+    host_call *call = static_cast<host_call *>(user_data);
+    try {
+        call->invoke(call->host, tasks(world, ticket, count));
+    } catch (...) {
+        call->thrown = std::current_exception();
+    }
+}
+
+} // namespace detail
+
+/** A world made by mpca_world_create, destroyed with the object. */
+class world {
+public:
+    /** mpca_world_create; throws mpca::error if `desc` is refused. */
+    explicit world(const mpca_desc &desc) : w_(nullptr) { check(mpca_world_create(&desc, &w_)); }
+
+    ~world() { reset(); }
+
+    world(world &&other) noexcept : w_(other.w_) { other.w_ = nullptr; }
+
+    world &operator=(world &&other) noexcept {
+        if (this != &other) {
+            reset();
+            w_ = other.w_;
+            other.w_ = nullptr;
+        }
+        return *this;
+    }
+
+    world(const world &) = delete;
+    world &operator=(const world &) = delete;
+
+    /** The handle, for the functions of mpca.h this class does not wrap;
+     * still owned by this object. NULL when empty. */
+    mpca_world *get() const noexcept { return w_; }
+
+    /** Whether this object holds a world (it does until moved from or reset). */
+    explicit operator bool() const noexcept { return w_ != nullptr; }
+
+    /** Destroys the world now; the object is empty afterwards. */
+    void reset() noexcept {
+        if (w_ != nullptr) {
+            mpca_world_destroy(w_);
+            w_ = nullptr;
+        }
+    }
+
+    // --- particles --------------------------------------------------------
+
+    /** A particle of the world's mass (mpca_world_add_particle). */
+    void add_particle(const cell_pos &pos, const vec3 &velocity) {
+        check(mpca_world_add_particle(w_, pos.data(), velocity.data()));
+    }
+
+    /** A particle of mass `mass` (mpca_world_add_particle_mass). */
+    void add_particle(const cell_pos &pos, const vec3 &velocity, float mass) {
+        check(mpca_world_add_particle_mass(w_, pos.data(), velocity.data(), mass));
+    }
+
+    /** Removes the particle at `pos` and returns it. */
+    mpca_particle remove_particle(const cell_pos &pos) {
+        mpca_particle p = mpca_particle();
+        check(mpca_world_remove_particle(w_, pos.data(), &p));
+        return p;
+    }
+
+    /** What the cell at `pos` holds. */
+    mpca_cell cell(const cell_pos &pos) const {
+        mpca_cell c = mpca_cell();
+        check(mpca_world_cell(w_, pos.data(), &c));
+        return c;
+    }
+
+    /** The number of particles now. */
+    std::size_t particle_count() const {
+        std::size_t n = 0;
+        check(mpca_world_particle_count(w_, &n));
+        return n;
+    }
+
+    // --- stepping ----------------------------------------------------------
+
+    /** Advances `steps` steps (mpca_world_step). */
+    void step(std::uint64_t steps = 1) { check(mpca_world_step(w_, steps)); }
+
+    /**
+     * Advances `steps` steps, each split into at most `max_tasks` tasks
+     * (mpca_world_step_parallel): `host(const mpca::tasks &t)` is called
+     * once a step and must run t(i) for each i below t.count(), on any of
+     * its threads, returning once all have returned. The world is the one
+     * step() gives, bit for bit.
+     *
+     * If the host throws, the step it was in is still completed (the
+     * library runs the tasks the host did not), no later step is taken,
+     * and the exception is thrown again from here.
+     */
+    template <class Host>
+    void step_parallel(std::uint64_t steps, std::uint32_t max_tasks, Host &&host) {
+        typedef typename std::remove_reference<Host>::type host_type;
+        detail::host_call call;
+        call.host = const_cast<void *>(static_cast<const void *>(std::addressof(host)));
+        call.invoke = &detail::invoke_host<host_type>;
+        // One C call a step, so that a throw ends the loop after its step.
+        for (std::uint64_t s = 0; s < steps; s++) {
+            check(mpca_world_step_parallel(w_, 1, max_tasks, &detail::mpca_hpp_run_tasks, &call));
+            if (call.thrown) {
+                std::rethrow_exception(call.thrown);
+            }
+        }
+    }
+
+    // --- reading the world ---------------------------------------------------
+
+    /** Statistics (mpca_world_stats). */
+    mpca_stats stats() const {
+        mpca_stats s = mpca_stats();
+        s.struct_size = sizeof s;
+        check(mpca_world_stats(w_, &s));
+        return s;
+    }
+
+    /** The hash of every particle (mpca_world_hash). */
+    std::uint64_t hash() const {
+        std::uint64_t h = 0;
+        check(mpca_world_hash(w_, &h));
+        return h;
+    }
+
+    /** The description the world was built from, with later changes. */
+    mpca_desc desc() const {
+        mpca_desc d = mpca_desc();
+        check(mpca_world_desc(w_, &d));
+        return d;
+    }
+
+    /** Positions, 3 floats a particle (cell centres), in cell order. */
+    std::vector<float> positions() const { return gather(&mpca_world_export_positions, 3); }
+
+    /** Velocities, 3 floats a particle, in the order of positions(). */
+    std::vector<float> velocities() const { return gather(&mpca_world_export_velocities, 3); }
+
+    /** Masses, one float a particle, in the order of positions(). */
+    std::vector<float> masses() const { return gather(&mpca_world_export_masses, 1); }
+
+    /**
+     * Positions into the caller's buffer of `capacity` particles (3 *
+     * capacity floats). Returns the particle count; the buffer was filled
+     * only if that is not above `capacity`. nullptr with capacity 0 asks
+     * for the count alone.
+     */
+    std::size_t export_positions(float *out, std::size_t capacity) const {
+        return fill(&mpca_world_export_positions, out, capacity);
+    }
+
+    /** Velocities into the caller's buffer; as export_positions. */
+    std::size_t export_velocities(float *out, std::size_t capacity) const {
+        return fill(&mpca_world_export_velocities, out, capacity);
+    }
+
+    /** Masses into the caller's buffer (one float a particle); as export_positions. */
+    std::size_t export_masses(float *out, std::size_t capacity) const {
+        return fill(&mpca_world_export_masses, out, capacity);
+    }
+
+    /** The share of occupied cells in each of res[0] x res[1] x res[2]
+     * bins (res[2] is 1 in 2D), x fastest (mpca_world_density). */
+    std::vector<float> density(const cell_pos &res) const {
+        std::vector<float> out(bins(res));
+        float none = 0;
+        check(mpca_world_density(w_, res.data(), out.empty() ? &none : out.data(), out.size()));
+        return out;
+    }
+
+    /** As density(), scaled to bytes 0..255 (mpca_world_density_u8). */
+    std::vector<std::uint8_t> density_u8(const cell_pos &res) const {
+        std::vector<std::uint8_t> out(bins(res));
+        std::uint8_t none = 0;
+        check(mpca_world_density_u8(w_, res.data(), out.empty() ? &none : out.data(), out.size()));
+        return out;
+    }
+
+    // --- forces, obstacles, emitters ------------------------------------------
+
+    /** The uniform acceleration (mpca_world_set_gravity). */
+    void set_gravity(const vec3 &g) { check(mpca_world_set_gravity(w_, g.data())); }
+
+    /** Obstacle cells with centres in the box min <= c <= max. */
+    void add_box(const vec3 &min, const vec3 &max, float e) {
+        check(mpca_world_add_box(w_, min.data(), max.data(), e));
+    }
+
+    /** An obstacle disc (2D). */
+    void add_disc(float cx, float cy, float radius, float e) { check(mpca_world_add_disc(w_, cx, cy, radius, e)); }
+
+    /** An obstacle sphere (3D). */
+    void add_sphere(const vec3 &centre, float radius, float e) {
+        check(mpca_world_add_sphere(w_, centre.data(), radius, e));
+    }
+
+    /** Obstacle cells beyond the plane through `point` with outward `normal`. */
+    void add_half_space(const vec3 &point, const vec3 &normal, float e) {
+        check(mpca_world_add_half_space(w_, point.data(), normal.data(), e));
+    }
+
+    /** Adds an emitter and returns its index; sets its struct_size. */
+    std::uint32_t add_emitter(mpca_emitter emitter) {
+        emitter.struct_size = sizeof emitter;
+        std::uint32_t index = 0;
+        check(mpca_world_add_emitter(w_, &emitter, &index));
+        return index;
+    }
+
+    /** Changes the rate of emitter `index`. */
+    void set_emitter_rate(std::uint32_t index, float rate) { check(mpca_world_set_emitter_rate(w_, index, rate)); }
+
+private:
+    typedef mpca_status (*export_fn)(const mpca_world *, float *, std::size_t, std::size_t *);
+
+    std::size_t fill(export_fn fn, float *out, std::size_t capacity) const {
+        std::size_t count = 0;
+        mpca_status s = fn(w_, out, capacity, &count);
+        if (s != MPCA_STATUS_OUTPUT_TOO_SMALL) {
+            check(s);
+        }
+        return count;
+    }
+
+    std::vector<float> gather(export_fn fn, std::size_t per) const {
+        std::size_t count = fill(fn, nullptr, 0); // the size query
+        std::vector<float> out(count * per);
+        if (count > 0) {
+            std::size_t written = 0;
+            check(fn(w_, out.data(), count, &written));
+        }
+        return out;
+    }
+
+    static std::size_t bins(const cell_pos &res) {
+        std::size_t n = 1;
+        for (std::size_t i = 0; i < 3; i++) {
+            if (res[i] != 0 && n > std::numeric_limits<std::size_t>::max() / res[i]) {
+                throw error(MPCA_STATUS_BAD_RESOLUTION);
+            }
+            n *= res[i];
+        }
+        return n;
+    }
+
+    mpca_world *w_;
+};
+
+} // namespace mpca
+
+#endif /* MPCA_HPP */

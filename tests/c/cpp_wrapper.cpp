@@ -1,0 +1,379 @@
+/*
+ * include/mpca.hpp, the C++11 wrapper, tried against the C ABI it wraps
+ * (built with -std=c++11 -Wall -Wextra -Wpedantic -Werror and run by
+ * tests/tests/c_abi.rs):
+ *
+ * - ownership: mpca::world moves and never copies; the world a moved-from,
+ *   reassigned, reset or destroyed object held is gone (its handle is
+ *   refused by the library);
+ * - errors: every refusal throws mpca::error with the status and
+ *   mpca_status_message's text, and changes nothing;
+ * - the wrapper gives what the C calls give: a scene built both ways
+ *   hashes equal, and the exports are the same bytes;
+ * - step_parallel with a lambda, a std::function on two std::threads, a
+ *   host that throws (the step completes, the exception comes back, no
+ *   later step runs) and misused tasks.
+ *
+ * Prints "sanitizer: address" or "none" first (as the C programs do),
+ * "cpp: GROUP" for each group it finished and "cpp checks: N
+ * failed: M" last; exits 1 if any check failed.
+ */
+/* First, so that the test fails if mpca.hpp does not include what it uses. */
+#include "mpca.hpp"
+
+#include <atomic>
+#include <cstdio>
+#include <cstring>
+#include <functional>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+/* As tests/c/check.c: GCC says __SANITIZE_ADDRESS__, Clang __has_feature. */
+#if defined(__SANITIZE_ADDRESS__)
+#define CPP_ASAN 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define CPP_ASAN 1
+#endif
+#endif
+
+static unsigned checks, failed;
+
+static void check_true(bool ok, const char *what, int line) {
+    checks++;
+    if (!ok) {
+        failed++;
+        std::printf("FAILED line %d: %s\n", line, what);
+    }
+}
+#define CHECK(cond) check_true((cond), #cond, __LINE__)
+
+/* `call` must throw mpca::error with status `want` and its message. */
+#define THROWS(want, call)                                                                            \
+    do {                                                                                              \
+        bool thrown_ = false;                                                                         \
+        try {                                                                                         \
+            call;                                                                                     \
+        } catch (const mpca::error &e_) {                                                             \
+            thrown_ = true;                                                                           \
+            check_true(e_.status() == (want), #call ": the status", __LINE__);                        \
+            check_true(std::strcmp(e_.what(), mpca_status_message(want)) == 0, #call ": the message", \
+                       __LINE__);                                                                     \
+        }                                                                                             \
+        check_true(thrown_, #call " throws mpca::error", __LINE__);                                   \
+    } while (0)
+
+static_assert(!std::is_copy_constructible<mpca::world>::value, "a world is not copied");
+static_assert(!std::is_copy_assignable<mpca::world>::value, "a world is not copied");
+static_assert(std::is_nothrow_move_constructible<mpca::world>::value, "a world moves");
+static_assert(std::is_nothrow_move_assignable<mpca::world>::value, "a world moves");
+static_assert(std::is_base_of<std::runtime_error, mpca::error>::value, "mpca::error is a std::runtime_error");
+
+/* Whether the library still knows the handle. */
+static bool alive(mpca_world *w) {
+    std::uint64_t h = 0;
+    return mpca_world_hash(w, &h) == MPCA_STATUS_OK;
+}
+
+/* A walled 2D box under gravity with a row of particles: the scene built
+ * through the wrapper and through the C functions alike. */
+static mpca_desc box_desc() {
+    mpca_desc d = mpca::desc_2d(32, 32);
+    d.seed = 11;
+    for (int k = 0; k < 2; k++) {
+        d.boundary[k][0] = d.boundary[k][1] = MPCA_BOUNDARY_WALL;
+    }
+    d.forces = MPCA_FORCE_UNIFORM;
+    d.gravity[1] = -0.02f;
+    d.restitution = 0.7f;
+    d.per_particle_mass = 1;
+    d.mass_classes = 2;
+    return d;
+}
+
+static float speed(std::uint32_t x) { return 0.1f * static_cast<float>(x % 7) - 0.3f; }
+
+static void fill_box(mpca::world &w) {
+    for (std::uint32_t x = 2; x < 30; x++) {
+        for (std::uint32_t y = 20; y < 24; y++) {
+            if (x % 3 == 0) {
+                w.add_particle({x, y, 0}, {speed(x), 0.1f, 0.0f}, 2.0f);
+            } else {
+                w.add_particle({x, y, 0}, {speed(x), -0.1f, 0.0f});
+            }
+        }
+    }
+}
+
+static void ownership() {
+    const mpca_desc d = box_desc();
+    mpca_world *held = nullptr;
+    {
+        mpca::world a(d);
+        held = a.get();
+        CHECK(a && held != nullptr && alive(held));
+    }
+    CHECK(!alive(held)); /* the destructor destroyed it */
+
+    mpca::world a(d);
+    mpca_world *raw_a = a.get();
+    mpca::world b(std::move(a));
+    CHECK(!a && a.get() == nullptr && b.get() == raw_a && alive(raw_a));
+    THROWS(MPCA_STATUS_NULL_POINTER, a.step(1));
+    THROWS(MPCA_STATUS_NULL_POINTER, a.hash());
+
+    mpca::world c(d);
+    mpca_world *raw_c = c.get();
+    c = std::move(b); /* c's own world is destroyed, a's moves in */
+    CHECK(!alive(raw_c) && c.get() == raw_a && !b && alive(raw_a));
+    mpca::world &same = c;
+    c = std::move(same); /* self-move keeps the world */
+    CHECK(c.get() == raw_a && alive(raw_a));
+    c.reset();
+    CHECK(!c && !alive(raw_a));
+    c.reset(); /* empty: nothing to do */
+    std::printf("cpp: ownership\n");
+}
+
+static void errors() {
+    mpca_desc odd = mpca::desc_2d(32, 32);
+    odd.size[0] = 31;
+    THROWS(MPCA_STATUS_SIZE_ODD, mpca::world w(odd));
+    /* mpca_desc_defaults takes any size; the world refuses it. */
+    const mpca_desc zero = mpca::desc_3d(0, 0, 0);
+    THROWS(MPCA_STATUS_SIZE_ZERO, mpca::world w(zero));
+
+    mpca::world w(box_desc());
+    fill_box(w);
+    const std::uint64_t before = w.hash();
+    THROWS(MPCA_STATUS_OUT_OF_BOUNDS, w.add_particle({32, 0, 0}, {0.0f, 0.0f, 0.0f}));
+    THROWS(MPCA_STATUS_CELL_OCCUPIED, w.add_particle({2, 20, 0}, {0.0f, 0.0f, 0.0f}));
+    THROWS(MPCA_STATUS_SPEED_RANGE, w.add_particle({1, 1, 0}, {1.5f, 0.0f, 0.0f}));
+    THROWS(MPCA_STATUS_MASS_RANGE, w.add_particle({1, 1, 0}, {0.0f, 0.0f, 0.0f}, -1.0f));
+    THROWS(MPCA_STATUS_NO_PARTICLE, w.remove_particle({1, 1, 0}));
+    THROWS(MPCA_STATUS_NOT_FINITE, w.set_gravity({0.0f, std::numeric_limits<float>::quiet_NaN(), 0.0f}));
+    THROWS(MPCA_STATUS_BAD_RESOLUTION, w.density({0, 4, 1}));
+    THROWS(MPCA_STATUS_BAD_RESOLUTION, w.density_u8({4, 4, 2}));
+    THROWS(MPCA_STATUS_NOT_ENABLED, w.add_disc(16.0f, 16.0f, 4.0f, 1.0f)); /* no obstacles in this world */
+    THROWS(MPCA_STATUS_OUT_OF_BOUNDS, w.set_emitter_rate(0, 1.0f)); /* no emitter 0 */
+    THROWS(MPCA_STATUS_BAD_EMITTER, w.set_emitter_rate(0, -1.0f));
+    CHECK(w.hash() == before);
+
+    /* Caught as what it derives from, too. */
+    bool caught = false;
+    try {
+        w.add_particle({0, 32, 0}, {0.0f, 0.0f, 0.0f});
+    } catch (const std::exception &e) {
+        caught = std::string(e.what()) == mpca_status_message(MPCA_STATUS_OUT_OF_BOUNDS);
+    }
+    CHECK(caught && w.hash() == before);
+    std::printf("cpp: errors\n");
+}
+
+/* The same scene through mpca.h alone. */
+static mpca_world *box_in_c() {
+    mpca_desc d = box_desc();
+    mpca_world *w = nullptr;
+    CHECK(mpca_world_create(&d, &w) == MPCA_STATUS_OK);
+    for (std::uint32_t x = 2; x < 30; x++) {
+        for (std::uint32_t y = 20; y < 24; y++) {
+            std::uint32_t pos[3] = {x, y, 0};
+            float v[3] = {speed(x), x % 3 == 0 ? 0.1f : -0.1f, 0.0f};
+            mpca_status s = x % 3 == 0 ? mpca_world_add_particle_mass(w, pos, v, 2.0f) : mpca_world_add_particle(w, pos, v);
+            CHECK(s == MPCA_STATUS_OK);
+        }
+    }
+    return w;
+}
+
+static void same_as_c() {
+    mpca::world w(box_desc());
+    fill_box(w);
+    mpca_world *c = box_in_c();
+    w.step(40);
+    CHECK(mpca_world_step(c, 40) == MPCA_STATUS_OK);
+
+    std::uint64_t hash_c = 0;
+    CHECK(mpca_world_hash(c, &hash_c) == MPCA_STATUS_OK);
+    CHECK(w.hash() == hash_c);
+    mpca_stats sc;
+    std::memset(&sc, 0, sizeof sc);
+    sc.struct_size = sizeof sc;
+    CHECK(mpca_world_stats(c, &sc) == MPCA_STATUS_OK);
+    const mpca_stats sw = w.stats();
+    CHECK(sw.step == 40 && sw.particles == sc.particles && sw.collisions == sc.collisions && sc.collisions > 0);
+    CHECK(sw.particles == 4 * 28 && w.particle_count() == sw.particles);
+    CHECK(w.desc().seed == 11);
+
+    const std::size_t n = w.particle_count();
+    std::vector<float> pos_c(3 * n), vel_c(3 * n), mass_c(n);
+    std::size_t count = 0;
+    CHECK(mpca_world_export_positions(c, pos_c.data(), n, &count) == MPCA_STATUS_OK && count == n);
+    CHECK(mpca_world_export_velocities(c, vel_c.data(), n, &count) == MPCA_STATUS_OK && count == n);
+    CHECK(mpca_world_export_masses(c, mass_c.data(), n, &count) == MPCA_STATUS_OK && count == n);
+    CHECK(w.positions() == pos_c);
+    CHECK(w.velocities() == vel_c);
+    CHECK(w.masses() == mass_c);
+
+    /* The caller's buffer: the size query, too small (untouched), enough. */
+    CHECK(w.export_positions(nullptr, 0) == n);
+    CHECK(w.export_masses(nullptr, 0) == n);
+    std::vector<float> buffer(3 * n, -7.0f);
+    CHECK(w.export_velocities(buffer.data(), n - 1) == n);
+    CHECK(buffer == std::vector<float>(3 * n, -7.0f));
+    CHECK(w.export_velocities(buffer.data(), n) == n && buffer == vel_c);
+
+    /* Density at the world's resolution is the occupancy. */
+    std::vector<float> occupancy = w.density({32, 32, 1});
+    double sum = 0;
+    for (std::size_t i = 0; i < occupancy.size(); i++) {
+        sum += occupancy[i];
+    }
+    CHECK(occupancy.size() == 32 * 32 && sum == static_cast<double>(n));
+    std::vector<std::uint8_t> bytes = w.density_u8({4, 4, 1});
+    CHECK(bytes.size() == 16);
+
+    /* A particle removed from both: the worlds stay equal. */
+    const std::uint32_t at[3] = {static_cast<std::uint32_t>(pos_c[0]), static_cast<std::uint32_t>(pos_c[1]), 0};
+    mpca_particle pc;
+    CHECK(mpca_world_remove_particle(c, at, &pc) == MPCA_STATUS_OK);
+    const mpca_cell before = w.cell({at[0], at[1], 0});
+    const mpca_particle pw = w.remove_particle({at[0], at[1], 0});
+    CHECK(before.kind == MPCA_CELL_KIND_PARTICLE && std::memcmp(&pw, &pc, sizeof pw) == 0);
+    CHECK(w.cell({at[0], at[1], 0}).kind == MPCA_CELL_KIND_EMPTY);
+    CHECK(mpca_world_hash(c, &hash_c) == MPCA_STATUS_OK && w.hash() == hash_c);
+    CHECK(mpca_world_destroy(c) == MPCA_STATUS_OK);
+
+    /* Obstacles, emitters and gravity through the wrapper. */
+    mpca_desc d = mpca::desc_2d(32, 32);
+    d.obstacles = 1;
+    d.surface_capacity = 256;
+    d.emitter_capacity = 1;
+    d.forces = MPCA_FORCE_UNIFORM;
+    mpca::world o(d);
+    o.add_disc(16.0f, 12.0f, 4.0f, 0.8f);
+    o.add_box({0.0f, 0.0f, 0.0f}, {31.9f, 1.9f, 0.0f}, 0.5f);
+    o.add_half_space({0.0f, 30.0f, 0.0f}, {0.0f, -1.0f, 0.0f}, 0.5f);
+    o.set_gravity({0.0f, -0.01f, 0.0f});
+    mpca_emitter e = mpca_emitter();
+    e.min[0] = 4;
+    e.min[1] = 20;
+    e.max[0] = 28;
+    e.max[1] = 24;
+    e.rate = 2.0f;
+    e.mass = 1.0f;
+    CHECK(o.add_emitter(e) == 0);
+    o.step(10);
+    o.set_emitter_rate(0, 0.0f);
+    o.step(5);
+    CHECK(o.stats().emitted == 20 && o.cell({16, 12, 0}).kind == MPCA_CELL_KIND_OBSTACLE);
+    mpca_desc d3 = mpca::desc_3d(16, 16, 16);
+    d3.obstacles = 1;
+    d3.surface_capacity = 512;
+    mpca::world s(d3);
+    s.add_sphere({8.0f, 8.0f, 8.0f}, 3.0f, 1.0f);
+    CHECK(s.cell({8, 8, 8}).kind == MPCA_CELL_KIND_OBSTACLE && std::strcmp(mpca::version(), mpca_version()) == 0);
+    std::printf("cpp: same as C\n");
+}
+
+static void parallel() {
+    mpca::world serial(box_desc()), forward(box_desc()), threaded(box_desc());
+    fill_box(serial);
+    fill_box(forward);
+    fill_box(threaded);
+    serial.step(30);
+
+    /* A lambda host: a loop on this thread. */
+    unsigned calls = 0;
+    forward.step_parallel(30, 8, [&calls](const mpca::tasks &t) {
+        calls++;
+        for (std::uint32_t i = 0; i < t.count(); i++) {
+            t(i);
+        }
+    });
+    CHECK(calls == 30 && forward.hash() == serial.hash());
+
+    /* A std::function host on two std::threads, odd and even tasks. */
+    std::atomic<unsigned> refused(0);
+    std::function<void(const mpca::tasks &)> two_threads = [&refused](const mpca::tasks &t) {
+        auto half = [&refused, &t](std::uint32_t first) {
+            for (std::uint32_t i = first; i < t.count(); i += 2) {
+                if (t.run(i) != MPCA_STATUS_OK) {
+                    refused++;
+                }
+            }
+        };
+        std::thread other(half, 1);
+        half(0);
+        other.join();
+    };
+    threaded.step_parallel(30, 7, two_threads);
+    CHECK(refused == 0 && threaded.hash() == serial.hash());
+
+    /* Misuse inside a host: a task twice, an index past the count, another
+     * call on the world; a task kept past its step. */
+    mpca::world misused(box_desc());
+    fill_box(misused);
+    std::vector<mpca::tasks> kept;
+    misused.step_parallel(1, 4, [&misused, &kept](const mpca::tasks &t) {
+        kept.push_back(t);
+        t(0);
+        THROWS(MPCA_STATUS_TASK_DONE, t(0));
+        THROWS(MPCA_STATUS_TASK_INDEX, t(t.count()));
+        THROWS(MPCA_STATUS_BUSY, misused.step(1));
+        THROWS(MPCA_STATUS_BUSY, misused.hash());
+    });
+    CHECK(kept.size() == 1 && kept[0].run(0) == MPCA_STATUS_STALE_TASK);
+    mpca::world one(box_desc());
+    fill_box(one);
+    one.step(1);
+    CHECK(misused.hash() == one.hash()); /* tasks the host skipped were run */
+
+    /* A host that throws in its third step: that step completes, the
+     * exception comes back, and the other seven steps are not taken. */
+    mpca::world thrower(box_desc());
+    fill_box(thrower);
+    unsigned hosted = 0;
+    std::string message;
+    try {
+        thrower.step_parallel(10, 4, [&hosted](const mpca::tasks &t) {
+            if (++hosted == 3) {
+                t(1);
+                throw std::runtime_error("the host gave up");
+            }
+            for (std::uint32_t i = 0; i < t.count(); i++) {
+                t(i);
+            }
+        });
+    } catch (const std::runtime_error &e) {
+        message = e.what();
+    }
+    mpca::world three(box_desc());
+    fill_box(three);
+    three.step(3);
+    CHECK(message == "the host gave up" && hosted == 3);
+    CHECK(thrower.stats().step == 3 && thrower.hash() == three.hash());
+    thrower.step(1); /* and the world goes on */
+    three.step(1);
+    CHECK(thrower.hash() == three.hash());
+    std::printf("cpp: parallel\n");
+}
+
+int main() {
+#if defined(CPP_ASAN)
+    std::printf("sanitizer: address\n");
+#else
+    std::printf("sanitizer: none\n");
+#endif
+    ownership();
+    errors();
+    same_as_c();
+    parallel();
+    std::printf("cpp checks: %u failed: %u\n", checks, failed);
+    return failed == 0 ? 0 : 1;
+}
