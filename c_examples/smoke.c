@@ -14,6 +14,18 @@
 
 #include "render.h"
 
+/* Built a second time with -DSMOKE_FLOW as `smoke-flow` (M5.1b, beyond the
+ * paper; tests/src/scenes.rs `smoke_flow()`): the same emitter and vortex
+ * geometry, but the smoke is buoyancy (an upward acceleration of 0.004)
+ * plus drag at rate 0.05 towards the vortex read as a velocity field
+ * (circulation 9 at the paper's size), with the calibrated drift rule and
+ * speed-limited collisions, instead of the paper's vortex force. */
+#ifdef SMOKE_FLOW
+#define CIRCULATION 9.0f
+#else
+#define CIRCULATION 2.0f
+#endif
+
 #define PAPER_SIZE 128
 #define PI_F 3.14159265358979323846f
 
@@ -24,7 +36,7 @@ typedef struct smoke_geometry {
 
 static smoke_geometry geometry(uint32_t size) {
     const float s = (float)size / PAPER_SIZE;
-    smoke_geometry g = {{64.0f * s, 72.0f * s}, 10.0f * s, 2.0f * s, {0, 0}, {0, 0}};
+    smoke_geometry g = {{64.0f * s, 72.0f * s}, 10.0f * s, CIRCULATION * s, {0, 0}, {0, 0}};
     g.emit_min[0] = scale_cells(60, size, PAPER_SIZE);
     g.emit_max[0] = scale_cells(68, size, PAPER_SIZE);
     g.emit_max[1] = scale_cells(2, size, PAPER_SIZE);
@@ -38,13 +50,21 @@ static mpca_world *build(const scene_opts *o) {
     const smoke_geometry g = geometry(o->size);
     mpca_desc d;
     mpca_check(mpca_desc_defaults(&d, 2, o->size, o->size, 0), "mpca_desc_defaults");
-    d.drift = MPCA_DRIFT_PAPER; /* the paper's rule, as printed */
     for (int axis = 0; axis < 2; axis++) {
         d.boundary[axis][0] = d.boundary[axis][1] = MPCA_BOUNDARY_OPEN;
     }
     d.boundary[1][0] = MPCA_BOUNDARY_WALL; /* the ground */
     d.restitution = 1.0f;
+#ifdef SMOKE_FLOW
+    d.collisions = MPCA_COLLISIONS_SPEED_LIMITED;
+    d.forces = MPCA_FORCE_UNIFORM;
+    d.gravity[1] = 0.004f;
+    d.drag_rate = 0.05f;
+    d.drag_vortex = 1;
+#else
+    d.drift = MPCA_DRIFT_PAPER; /* the paper's rule, as printed */
     d.forces = MPCA_FORCE_VORTEX;
+#endif
     d.vortex_centre[0] = g.centre[0];
     d.vortex_centre[1] = g.centre[1];
     d.vortex_core_radius = g.core;
@@ -109,6 +129,17 @@ static drawn draw(const scene_opts *o, mpca_world *w, const view *v) {
 }
 
 int main(int argc, char **argv) {
+#ifdef SMOKE_FLOW
+    const scene s = {
+        .name = "smoke-flow",
+        .title = "4.3 smoke with flow drag (M5.1b)",
+        .dim = 2,
+        .defaults = {.size = PAPER_SIZE, .steps = 1200, .seed = 43, .every = 100, .tiles = 6, .px = 512},
+        .about = "buoyant smoke dragged towards a Rankine vortex flow: it rises at its terminal speed and rolls up",
+        .build = build,
+        .draw = draw,
+    };
+#else
     const scene s = {
         .name = "smoke",
         .title = "4.3 smoke",
@@ -118,5 +149,6 @@ int main(int argc, char **argv) {
         .build = build,
         .draw = draw,
     };
+#endif
     return scene_main(&s, argc, argv);
 }

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The paper's four scenes, rendered: installs what is missing (Debian or
 # Ubuntu), builds libmpca and the C programs of c_examples/, runs the four
-# scenes at full size (and the smoke scene a second, longer time), and says
+# scenes at full size (and the smoke scene a second, longer time, and with
+# flow drag, M5.1b), and says
 # where the images are and how long the simulation took.
 #
 #   scripts/run-scenes.sh [--out DIR] [--docs]
@@ -47,7 +48,7 @@ make -C c_examples --no-print-directory MPCA_LIB="$lib" BUILD="$bin" CC="$cc"
 echo "== the scenes, full size, images in $out"
 logs=$(mktemp -d)
 trap 'rm -rf "$logs"' EXIT
-runs=(aggregation cluster smoke water smoke-long)
+runs=(aggregation cluster smoke water smoke-long smoke-flow)
 for run in "${runs[@]}"; do
     case "$run" in
         smoke-long) args=(smoke --steps 480 --every 40 --name smoke-long) ;;
@@ -94,6 +95,7 @@ if [ "$docs" -eq 1 ]; then
             small="$logs/px$px"
             case "$run" in
                 smoke-long) "$bin/smoke" --steps 480 --every 0 --name smoke-long --px $px --out "$small" >/dev/null ;;
+                smoke-flow) "$bin/smoke-flow" --every 0 --px $px --out "$small" >/dev/null ;;
                 *) "$bin/$run" --every 0 --px $px --out "$small" >/dev/null ;;
             esac
             sheet="$small/$run-sheet.png"
@@ -103,13 +105,15 @@ if [ "$docs" -eq 1 ]; then
     done
     paper_s() { case "$1" in aggregation) echo 800;; cluster) echo 70;; smoke) echo 8;; water) echo 270;; *) echo "";; esac; }
     section() { case "$1" in aggregation) echo "4.1 aggregation";; cluster) echo "4.2 cluster collision";;
-        smoke) echo "4.3 smoke";; water) echo "4.4 water";; smoke-long) echo "4.3 smoke, longer run";; esac; }
+        smoke) echo "4.3 smoke";; water) echo "4.4 water";; smoke-long) echo "4.3 smoke, longer run";;
+        smoke-flow) echo "4.3 smoke with flow drag (M5.1b, beyond the paper)";; esac; }
     caption() { case "$1" in
         aggregation) echo "a gas at density 0.3 with e = 0.5 cools and gathers into clusters (slow, blue);";;
         cluster) echo "two discs meet at v = (±0.8, 0) and scatter, mostly across the line of flight;";;
         smoke) echo "one particle a step rises from the ground and the vortex (grey guides) bends the plume;";;
         water) echo "water poured on the sphere splashes off it and spreads over the floor;";;
-        smoke-long) echo "the same smoke for 480 steps: the vortex bends the plume round its right side and flings it out at the top right.";;
+        smoke-long) echo "the same smoke for 480 steps: the vortex bends the plume round its right side and flings it out at the top right;";;
+        smoke-flow) echo "the smoke as buoyancy plus drag towards the vortex's flow, 1,200 steps: it rises at its terminal speed (slow colours, no clamp) and is carried up round the vortex's right side instead of being flung out; it does not wind into the core, since its rise (0.08 cells a step) is over half the flow's speed at the core (0.14).";;
     esac; }
     # 12345 -> 12,345
     commas() { echo "$1" | sed ':a;s/\B[0-9]\{3\}\>/,&/;ta'; }
@@ -132,7 +136,7 @@ if [ "$docs" -eq 1 ]; then
         echo "It installs what is missing (\`make\`, \`libosmesa6-dev\`, \`libpng-dev\`,"
         echo "with \`apt-get\` as root or through \`sudo\`), builds \`libmpca\` in release"
         echo "mode and the programs with \`make\`, runs the four scenes at full size (and"
-        echo "the smoke scene a second time, for 480 steps) and prints where the images"
+        echo "the smoke scene a second time, for 480 steps, and with flow drag) and prints where the images"
         echo "are: \`out/scenes/\`. Each program also runs alone, e.g."
         echo "\`target/c_examples/water --size 32 --steps 200 --every 20 --out /tmp/w\`;"
         echo "\`--help\` lists its options (\`--size --steps --seed --every --tiles --px --out --name --threads --version\`)."

@@ -120,7 +120,7 @@ pub fn smoke_flow() -> Scene {
     desc.drag = mpca::Drag { rate: 0.05, wind: [0.0; 3], vortex: true };
     desc.emitter_capacity = 1;
     desc.seed = 43;
-    Scene { name: "smoke-flow", section: "4.3b", desc, steps: 480, paper_seconds: f64::NAN, setup: fill_smoke }
+    Scene { name: "smoke-flow", section: "4.3b", desc, steps: 1200, paper_seconds: f64::NAN, setup: fill_smoke }
 }
 
 fn fill_smoke(w: &mut World) -> Result<(), Error> {

@@ -336,12 +336,14 @@ fn water_small_run_draws_the_sphere_the_box_and_the_water() {
 /// bit (`mpca_world_hash` against `World::state_hash`), as the scene of
 /// tests/src/scenes.rs after the same steps; stepped serially, and in the
 /// parallel step (M11) on 1, 2 and 3 POSIX threads (4, 8 and 12 tasks).
+/// The same for `smoke-flow`, the smoke with flow drag (M5.1b).
 #[test]
 fn the_c_scenes_are_the_rust_scenes() {
     const STEPS: u64 = 6;
     let out_dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("examples").join("paper-size");
     let out_s = out_dir.to_string_lossy().into_owned();
-    let scenes: Vec<Scene> = paper_scenes().into();
+    let mut scenes: Vec<Scene> = paper_scenes().into();
+    scenes.push(mpca_tests::scenes::smoke_flow());
     let mut memory = Vec::new();
     for scene in &scenes {
         let world = build(scene, &mut memory).expect("the Rust scene builds");
