@@ -124,15 +124,13 @@ pub fn smoke_flow() -> Scene {
 }
 
 fn fill_smoke(w: &mut World) -> Result<(), Error> {
-    w.add_emitter(Emitter {
-        min: [60, 0, 0],
-        max: [68, 2, 1],
-        rate: 1.0,
-        velocity: [0.0, 0.6, 0.0],
-        spread: 0.2,
-        mass: 1.0,
-        lifetime: 0,
-    })?;
+    smoke_emitter(w, [60, 0, 0], [68, 2, 1])
+}
+
+/// The smoke's emitter over cells `min..max`: one particle a step at
+/// (0, 0.6) with a spread of 0.2.
+fn smoke_emitter(w: &mut World, min: [u32; 3], max: [u32; 3]) -> Result<(), Error> {
+    w.add_emitter(Emitter { min, max, rate: 1.0, velocity: [0.0, 0.6, 0.0], spread: 0.2, mass: 1.0, lifetime: 0 })?;
     Ok(())
 }
 
@@ -150,16 +148,7 @@ pub fn smoke_64() -> Scene {
 }
 
 fn fill_smoke_64(w: &mut World) -> Result<(), Error> {
-    w.add_emitter(Emitter {
-        min: [30, 0, 0],
-        max: [34, 1, 1],
-        rate: 1.0,
-        velocity: [0.0, 0.6, 0.0],
-        spread: 0.2,
-        mass: 1.0,
-        lifetime: 0,
-    })?;
-    Ok(())
+    smoke_emitter(w, [30, 0, 0], [34, 1, 1])
 }
 
 /// 4.4 water: 3D 64^3, emitted at the top, gravity, a sphere obstacle in the
