@@ -100,6 +100,12 @@ impl BoxResult {
         (self.energy_end - self.energy_start) / self.energy_start / self.steps as f64
     }
 
+    /// The standard deviation of [`BoxResult::energy_drift_per_step`] that
+    /// rounding noise alone gives: a drift below it is not measured.
+    pub fn energy_noise_per_step(&self) -> f64 {
+        self.energy_sigma / self.energy_start / self.steps as f64
+    }
+
     /// `(E_end + clamped - E_start) / E_start / steps`: the drift with the
     /// clamps' removal put back, which rounding alone explains.
     pub fn energy_drift_without_clamps(&self) -> f64 {

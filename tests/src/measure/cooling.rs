@@ -128,19 +128,19 @@ impl CoolingResult {
     }
 }
 
-/// The gas: density 0.3, e = 0.8, speeds uniform in the unit ball scaled to
-/// 0.5, periodic box, no force.
-pub fn gas(dim: u32, n: u32, setting: Setting) -> Description {
+/// The gas: density 0.3, restitution `e`, speeds uniform in the unit ball
+/// scaled to 0.5, periodic box, no force.
+pub fn gas(dim: u32, n: u32, setting: Setting, e: f32) -> Description {
     let mut desc = cube(dim, n);
     setting.apply(&mut desc);
-    desc.restitution = 0.8;
+    desc.restitution = e;
     desc.seed = 60 + u64::from(dim);
     desc
 }
 
-/// Runs one cooling gas and fits it.
-pub fn measure(dim: u32, setting: Setting, cfg: CoolingConfig) -> CoolingResult {
-    let desc = gas(dim, cfg.n, setting);
+/// Runs one cooling gas of restitution `e` and fits it.
+pub fn measure(dim: u32, setting: Setting, e: f32, cfg: CoolingConfig) -> CoolingResult {
+    let desc = gas(dim, cfg.n, setting, e);
     let mut mem = memory(&desc);
     let ((series, collisions, particles, clamps, bytes_per_cell), timing) = repeat(cfg.runs, || {
         let world: &mut World = World::init(&desc, &mut mem).expect("fits");

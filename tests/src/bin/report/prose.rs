@@ -27,6 +27,19 @@ fn pct(v: f64) -> String {
 }
 
 /// The headline figures, looked up once.
+/// The restitutions of the cooling gas the headline reports.
+const COOLING_E: [f32; 2] = [0.5, 0.8];
+
+/// A measured figure with its noise: `v ± n`, and said to be below its noise
+/// where it is under three standard deviations of it.
+fn noisy(v: f64, n: f64) -> String {
+    if v.abs() < 3.0 * n {
+        format!("{} ± {} (within its noise)", sig(v), sig(n))
+    } else {
+        format!("{} ± {}", sig(v), sig(n))
+    }
+}
+
 struct Headline {
     drift: [(f64, f64, f64, f64); 2],
     /// The calibrated rule's drift error at 16 bits, 2D and 3D.
@@ -37,9 +50,14 @@ struct Headline {
     water_ms: [f64; 3],
     aggregation_ms: [f64; 3],
     energy: [(f64, f64); 2],
+    /// The rounding noise of those drifts (one sd per step).
+    energy_noise: [(f64, f64); 2],
     momentum_z: [(Option<f64>, Option<f64>); 2],
     energy_z: [(f64, f64); 2],
-    haff: [(f64, f64, f64, f64); 2],
+    /// Per dimension, per restitution of [`COOLING_E`]: Haff's τ, its
+    /// residual, the exponential's residual, the mean-field rate over the
+    /// exponential's.
+    haff: [[(f64, f64, f64, f64); 2]; 2],
     tilted: (f64, f64),
     kicked_70: f64,
     missed: usize,
@@ -83,11 +101,15 @@ fn headline(r: &Results) -> Headline {
         r.boxes.iter().find(|b| b.dim == dim && b.quant == q && b.regime == "slow" && b.method == Method::ExactFast).expect("measured")
     };
     let energy = [2u32, 3].map(|d| (boxes(d, Quantization::Bits8).energy_drift_per_step(), boxes(d, Quantization::Bits16).energy_drift_per_step()));
+    let energy_noise =
+        [2u32, 3].map(|d| (boxes(d, Quantization::Bits8).energy_noise_per_step(), boxes(d, Quantization::Bits16).energy_noise_per_step()));
     let momentum_z = [2u32, 3].map(|d| (boxes(d, Quantization::Bits8).momentum_z(), boxes(d, Quantization::Bits16).momentum_z()));
     let energy_z = [2u32, 3].map(|d| (boxes(d, Quantization::Bits8).energy_z(), boxes(d, Quantization::Bits16).energy_z()));
     let haff = [2u32, 3].map(|dim| {
-        let c = r.cooling.iter().find(|c| c.dim == dim && c.setting == Setting::DEFAULT).expect("measured");
-        (c.fit.tau, c.fit.residual, c.fit.residual_exp, c.mean_field_rate() * c.fit.tau_exp)
+        COOLING_E.map(|e| {
+            let c = r.cooling.iter().find(|c| c.dim == dim && c.restitution == e && c.setting == Setting::DEFAULT).expect("measured");
+            (c.fit.tau, c.fit.residual, c.fit.residual_exp, c.mean_field_rate() * c.fit.tau_exp)
+        })
     });
     let tilted_mean = |q| {
         let (rows, _) = r
@@ -136,6 +158,7 @@ fn headline(r: &Results) -> Headline {
         water_ms: scene_ms("water"),
         aggregation_ms: scene_ms("aggregation"),
         energy,
+        energy_noise,
         momentum_z,
         energy_z,
         haff,
@@ -194,12 +217,12 @@ fn summary(h: &Headline) -> String {
     let z = |v: Option<f64>| v.map_or("– (a clamp fired)".to_string(), sig);
     s += &format!(
         "- **Conservation (closed box, e = 1, slow particles):** energy drift per step {} (8-bit) and {} (16-bit) in 2D, {} \
-         and {} in 3D. With the mean gain rounding predicts taken off, what is left is {} / {} (2D) and {} / {} (3D) \
+         and {} in 3D (± one standard deviation of the rounding noise over the run). With the mean gain rounding predicts taken off, what is left is {} / {} (2D) and {} / {} (3D) \
          standard deviations of rounding noise; momentum moves by {} / {} (2D) and {} / {} (3D) standard deviations.\n",
-        sig(h.energy[0].0),
-        sig(h.energy[0].1),
-        sig(h.energy[1].0),
-        sig(h.energy[1].1),
+        noisy(h.energy[0].0, h.energy_noise[0].0),
+        noisy(h.energy[0].1, h.energy_noise[0].1),
+        noisy(h.energy[1].0, h.energy_noise[1].0),
+        noisy(h.energy[1].1, h.energy_noise[1].1),
         sig(h.energy_z[0].0),
         sig(h.energy_z[0].1),
         sig(h.energy_z[1].0),
@@ -210,7 +233,8 @@ fn summary(h: &Headline) -> String {
         z(h.momentum_z[1].1)
     );
     for (i, dim) in ["2D", "3D"].iter().enumerate() {
-        let (tau, res, res_exp, mf) = h.haff[i];
+      for (j, e) in COOLING_E.iter().enumerate() {
+        let (tau, res, res_exp, mf) = h.haff[i][j];
         let verdict = if res_exp < res {
             "the exponential describes the cooling better: M5.2 picks a pair whatever the particles' speeds, so the \
              collision frequency does not grow with sqrt(T) as Haff's law assumes"
@@ -218,7 +242,7 @@ fn summary(h: &Headline) -> String {
             "Haff's law describes the cooling better than an exponential"
         };
         s += &format!(
-            "- **Cooling ({dim}, e = 0.8, first decade):** Haff's law fits with τ = {} steps and an RMS residual of {}; an \
+            "- **Cooling ({dim}, e = {e}, first decade):** Haff's law fits with τ = {} steps and an RMS residual of {}; an \
              exponential fits with {}; {verdict}. The mean-field rate (1 − e²) × collisions per particle-step is {}× the \
              fitted exponential rate.\n",
             sig(tau),
@@ -226,6 +250,7 @@ fn summary(h: &Headline) -> String {
             pct(res_exp),
             sig(mf)
         );
+      }
     }
     s += &format!(
         "- **Obstacles:** {} particles found inside obstacles. Axis-aligned walls reflect exactly (0° error); off a wall \
@@ -408,12 +433,14 @@ pub fn readme_section(h: &Header, r: &Results) -> String {
         }
     }
     for (i, dim) in ["2D", "3D"].iter().enumerate() {
-        let (e8, e16) = hl.energy[i];
-        s += &format!("| energy drift, {dim} box, e = 1 | 8-bit / 16-bit | {} / {} per step | |\n", sig(e8), sig(e16));
+        let ((e8, e16), (n8, n16)) = (hl.energy[i], hl.energy_noise[i]);
+        s += &format!("| energy drift, {dim} box, e = 1 | 8-bit / 16-bit | {} / {} per step | |\n", noisy(e8, n8), noisy(e16, n16));
     }
     for (i, dim) in ["2D", "3D"].iter().enumerate() {
-        let (tau, res, res_exp, _) = hl.haff[i];
-        s += &format!("| cooling, {dim}, e = 0.8 | Haff fit (τ = {} steps) | {} RMS (exponential: {}) | |\n", sig(tau), pct(res), pct(res_exp));
+        for (j, e) in COOLING_E.iter().enumerate() {
+            let (tau, res, res_exp, _) = hl.haff[i][j];
+            s += &format!("| cooling, {dim}, e = {e} | Haff fit (τ = {} steps) | {} RMS (exponential: {}) | |\n", sig(tau), pct(res), pct(res_exp));
+        }
     }
     s += &format!("| reflection, wall tilted 30° | 8-bit / 16-bit | {}° / {}° | |\n", sig(hl.tilted.0), sig(hl.tilted.1));
     s += &format!("| particles inside obstacles | all settings | {} | |\n", hl.inside);
@@ -509,7 +536,7 @@ fn recommend(h: &Headline) -> String {
         sig(h.bytes_8_16[0].0),
         sig(h.time_16_over_8.1),
         sig(e2_8.abs()),
-        sig(e2_16.abs()),
+        noisy(e2_16.abs(), h.energy_noise[0].1),
         sig(h.tilted.0),
         sig(h.tilted.1),
         pct(h.drift[0].1),

@@ -146,14 +146,18 @@ pub fn all(cfg: &Config) -> Results {
 
     say("cooling: Haff's law");
     let mut cooling = vec![];
+    // Every setting at e = 0.8; the default one also at e = 0.5, since
+    // which law fits better depends on e.
     for setting in Setting::all() {
-        cooling.push(cooling::measure(2, setting, cfg.cooling_2d));
+        cooling.push(cooling::measure(2, setting, 0.8, cfg.cooling_2d));
     }
     for m in [Method::ExactFast, Method::Greedy] {
         for q in QUANTS {
-            cooling.push(cooling::measure(3, Setting { method: m, quant: q, ..Setting::DEFAULT }, cfg.cooling_3d));
+            cooling.push(cooling::measure(3, Setting { method: m, quant: q, ..Setting::DEFAULT }, 0.8, cfg.cooling_3d));
         }
     }
+    cooling.push(cooling::measure(2, Setting::DEFAULT, 0.5, cfg.cooling_2d));
+    cooling.push(cooling::measure(3, Setting::DEFAULT, 0.5, cfg.cooling_3d));
 
     say("obstacles: reflection and particles inside");
     let mut reflect = vec![];
