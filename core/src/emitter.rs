@@ -166,7 +166,9 @@ fn each_site(l: &crate::layout::Layout, e: &Emitter, mut f: impl FnMut(crate::la
 fn spread_velocity(e: &Emitter, dim: usize, rng: &mut Stream) -> [f32; 3] {
     let mut v = e.velocity;
     if e.spread > 0.0 {
-        let (dir, radius) = if dim == 2 {
+        // A build without 3D has only 2D worlds: the 3D branch (and cbrtf)
+        // is not linked into it.
+        let (dir, radius) = if dim == 2 || !cfg!(feature = "dim3") {
             (random_unit::<2>(rng), libm::sqrtf(rng.unit()))
         } else {
             (random_unit::<3>(rng), libm::cbrtf(rng.unit()))
