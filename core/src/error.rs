@@ -1,149 +1,189 @@
 //! Errors are values (STYLE.md practice 3): every refusal names its cause,
 //! and the world is left exactly as it was.
 
+use core::ffi::CStr;
 use core::fmt;
 
 /// Why the library refused a request. Nothing was changed when one of these
 /// is returned.
+///
+/// Each variant carries a number ([`Error::code`]) that the C ABI returns as
+/// its `mpca_status`. Numbers are never reused or changed: a new error takes
+/// a new one. 2 and 6 are shared with statuses the C ABI also returns for
+/// its own checks (a bad handle, a short output buffer); the rest lie in
+/// 100..199.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 #[non_exhaustive]
+#[repr(u32)]
 pub enum Error {
     /// The dimension is neither 2 nor 3.
-    BadDimension,
+    BadDimension = 100,
     /// 3D worlds need the `dim3` feature, which this build left out.
-    Dim3Disabled,
+    Dim3Disabled = 101,
     /// A size is zero (M1).
-    SizeZero,
+    SizeZero = 102,
     /// A size is odd, so Margolus blocks cannot tile the axis (M1).
-    SizeOdd,
+    SizeOdd = 103,
     /// The world's cell count, bit index or byte count overflows this target.
-    TooLarge,
+    TooLarge = 104,
     /// Only one face of an axis is periodic; periodicity joins both (M4).
-    PeriodicMismatch,
+    PeriodicMismatch = 105,
     /// A floating-point input is NaN or infinite.
-    NotFinite,
+    NotFinite = 106,
     /// The time step is negative.
-    NegativeDt,
+    NegativeDt = 107,
     /// The vortex core radius is not greater than zero.
-    BadVortex,
+    BadVortex = 108,
     /// A flow drag rate is negative (M5.1b).
-    BadDrag,
+    BadDrag = 140,
     /// A restitution lies outside `[0, 1]` (M1).
-    RestitutionRange,
+    RestitutionRange = 109,
     /// A mass is not strictly positive (M1).
-    MassRange,
+    MassRange = 110,
     /// A velocity has `|v| > 1` (M1).
-    SpeedRange,
+    SpeedRange = 111,
     /// 16-bit velocities need the `q16` feature, which this build left out.
-    Q16Disabled,
+    Q16Disabled = 112,
     /// The description asks for a part (obstacles, fields, per-particle
     /// masses) that this build left out.
-    FeatureDisabled,
+    FeatureDisabled = 113,
     /// The world was built without the part this call uses (M9).
-    NotEnabled,
+    NotEnabled = 114,
     /// A capacity in the description is beyond what the storage can index.
-    CapacityRange,
+    CapacityRange = 115,
     /// The buffer handed in is smaller than `world_bytes` asked for.
-    BufferTooSmall,
+    BufferTooSmall = 116,
     /// A position lies outside the world.
-    OutOfBounds,
+    OutOfBounds = 117,
     /// The cell already holds a particle.
-    CellOccupied,
+    CellOccupied = 118,
     /// The cell is an obstacle.
-    CellObstacle,
+    CellObstacle = 119,
     /// The cell holds no particle.
-    NoParticle,
+    NoParticle = 120,
     /// The table of distinct masses is full.
-    MassTableFull,
+    MassTableFull = 121,
     /// The obstacle surface table is full.
-    SurfaceTableFull,
+    SurfaceTableFull = 122,
     /// An obstacle surface cell would have no defined normal (M7).
-    UndefinedNormal,
+    UndefinedNormal = 123,
     /// The emitter table is full.
-    EmitterTableFull,
+    EmitterTableFull = 124,
     /// An emitter region is empty or reversed, or a rate is negative.
-    BadEmitter,
+    BadEmitter = 125,
     /// A lifetime is longer than the age plane can count.
-    LifetimeRange,
+    LifetimeRange = 126,
     /// A shape is degenerate (zero normal, reversed box, negative radius).
-    BadShape,
+    BadShape = 127,
     /// An output resolution is zero, larger than the world, or the output
     /// buffer has the wrong length.
-    BadResolution,
+    BadResolution = 128,
     /// A per-cell input slice has the wrong length.
-    BadLength,
+    BadLength = 129,
     /// The memory does not hold a world (wrong tag, destroyed or forged).
-    NotAWorld,
+    NotAWorld = 2,
     /// The world lives in caller memory; only the caller can free it.
-    NotOwned,
+    NotOwned = 131,
     /// The allocator refused the memory.
-    OutOfMemory,
+    OutOfMemory = 132,
     /// The output buffer is smaller than what is to be written into it
     /// ([`crate::World::snapshot_bytes`] for an image).
-    OutputTooSmall,
+    OutputTooSmall = 6,
     /// The bytes do not start with the magic of a world image (M12).
-    NotAnImage,
+    NotAnImage = 133,
     /// The image is of a format version this library does not read (M12).
-    ImageVersion,
+    ImageVersion = 134,
     /// The image is shorter or longer than its header says: cut short, or
     /// with bytes after its end (M12).
-    ImageLength,
+    ImageLength = 135,
     /// The image's checksum does not match its bytes: it was damaged (M12).
-    ImageChecksum,
+    ImageChecksum = 136,
     /// The image's checksum matches, but what it holds is not a world this
     /// library could have written: an unknown value, a count that does not
     /// add up, a particle on an obstacle, a velocity out of range (M12).
-    ImageInvalid,
+    ImageInvalid = 137,
     /// The image holds a world of another size or plan of planes than the
     /// world it is loaded into (M12).
-    ImageMismatch,
+    ImageMismatch = 138,
+}
+
+/// The one table of messages. It writes both [`Error::c_message`], whose
+/// match must name every variant, and [`Error::ALL`], so a variant cannot be
+/// added without being listed.
+macro_rules! messages {
+    ($($variant:ident => $text:literal,)*) => {
+        impl Error {
+            /// Every error, in declaration order: for the C ABI's check that
+            /// each one has its status.
+            pub const ALL: &'static [Error] = &[$(Error::$variant),*];
+
+            /// A short, static description of the error, NUL-terminated so
+            /// the C ABI hands out the same bytes without copying.
+            pub const fn c_message(self) -> &'static CStr {
+                match self {
+                    $(Error::$variant => $text,)*
+                }
+            }
+        }
+    };
+}
+
+messages! {
+    BadDimension => c"dimension must be 2 or 3",
+    Dim3Disabled => c"3D worlds are not built in (feature dim3)",
+    SizeZero => c"a world size is zero",
+    SizeOdd => c"a world size is odd; Margolus blocks need even sizes",
+    TooLarge => c"the world is too large for this target",
+    PeriodicMismatch => c"periodic boundaries must be set on both faces of an axis",
+    NotFinite => c"a floating-point input is NaN or infinite",
+    NegativeDt => c"the time step must not be negative",
+    BadVortex => c"the vortex core radius must be greater than zero",
+    BadDrag => c"the flow drag rate must not be negative",
+    RestitutionRange => c"a restitution lies outside [0, 1]",
+    MassRange => c"a mass must be greater than zero",
+    SpeedRange => c"a speed must not exceed 1 cell per step",
+    Q16Disabled => c"16-bit velocities are not built in (feature q16)",
+    FeatureDisabled => c"the description uses a part this build left out",
+    NotEnabled => c"the world was created without this part",
+    CapacityRange => c"a capacity is out of range",
+    BufferTooSmall => c"the memory is smaller than world_bytes asked for",
+    OutOfBounds => c"a position lies outside the world",
+    CellOccupied => c"the cell already holds a particle",
+    CellObstacle => c"the cell is an obstacle",
+    NoParticle => c"the cell holds no particle",
+    MassTableFull => c"the table of distinct masses is full",
+    SurfaceTableFull => c"the obstacle surface table is full",
+    UndefinedNormal => c"an obstacle surface cell would have no defined normal",
+    EmitterTableFull => c"the emitter table is full",
+    BadEmitter => c"an emitter region is empty or reversed, or its rate is negative",
+    LifetimeRange => c"a lifetime is longer than 65535 steps",
+    BadShape => c"a shape is degenerate",
+    BadResolution => c"the output resolution or buffer length is wrong",
+    BadLength => c"a per-cell input has the wrong length, or a length exceeds the largest object size",
+    NotAWorld => c"the memory does not hold a live world",
+    NotOwned => c"the world lives in caller memory; the caller frees it",
+    OutOfMemory => c"the allocator refused the memory",
+    OutputTooSmall => c"the output buffer is too small",
+    NotAnImage => c"the bytes are not an mpca world image",
+    ImageVersion => c"the image is of a format version this library does not read",
+    ImageLength => c"the image is shorter or longer than its header says",
+    ImageChecksum => c"the image's checksum does not match: it was damaged",
+    ImageInvalid => c"the image does not hold a consistent world",
+    ImageMismatch => c"the image holds a world of another size or layout than this one",
 }
 
 impl Error {
+    /// The error's stable number, the `mpca_status` the C ABI returns for it.
+    pub const fn code(self) -> u32 {
+        self as u32
+    }
+
     /// A short, static description of the error.
     pub const fn message(self) -> &'static str {
-        match self {
-            Error::BadDimension => "dimension must be 2 or 3",
-            Error::Dim3Disabled => "3D worlds are not built in (feature dim3)",
-            Error::SizeZero => "a world size is zero",
-            Error::SizeOdd => "a world size is odd; Margolus blocks need even sizes",
-            Error::TooLarge => "the world is too large for this target",
-            Error::PeriodicMismatch => "periodic boundaries must be set on both faces of an axis",
-            Error::NotFinite => "a floating-point input is NaN or infinite",
-            Error::NegativeDt => "the time step must not be negative",
-            Error::BadVortex => "the vortex core radius must be greater than zero",
-            Error::BadDrag => "the flow drag rate must not be negative",
-            Error::RestitutionRange => "a restitution lies outside [0, 1]",
-            Error::MassRange => "a mass must be greater than zero",
-            Error::SpeedRange => "a speed must not exceed 1 cell per step",
-            Error::Q16Disabled => "16-bit velocities are not built in (feature q16)",
-            Error::FeatureDisabled => "the description uses a part this build left out",
-            Error::NotEnabled => "the world was created without this part",
-            Error::CapacityRange => "a capacity is out of range",
-            Error::BufferTooSmall => "the memory is smaller than world_bytes asked for",
-            Error::OutOfBounds => "a position lies outside the world",
-            Error::CellOccupied => "the cell already holds a particle",
-            Error::CellObstacle => "the cell is an obstacle",
-            Error::NoParticle => "the cell holds no particle",
-            Error::MassTableFull => "the table of distinct masses is full",
-            Error::SurfaceTableFull => "the obstacle surface table is full",
-            Error::UndefinedNormal => "an obstacle surface cell would have no defined normal",
-            Error::EmitterTableFull => "the emitter table is full",
-            Error::BadEmitter => "an emitter region is empty or reversed, or its rate is negative",
-            Error::LifetimeRange => "a lifetime is longer than 65535 steps",
-            Error::BadShape => "a shape is degenerate",
-            Error::BadResolution => "the output resolution or buffer length is wrong",
-            Error::BadLength => "a per-cell input has the wrong length",
-            Error::NotAWorld => "the memory does not hold a live world",
-            Error::NotOwned => "the world lives in caller memory; the caller frees it",
-            Error::OutOfMemory => "the allocator refused the memory",
-            Error::OutputTooSmall => "the output buffer is too small",
-            Error::NotAnImage => "the bytes are not an mpca world image",
-            Error::ImageVersion => "the image is of a format version this library does not read",
-            Error::ImageLength => "the image is shorter or longer than its header says",
-            Error::ImageChecksum => "the image's checksum does not match: it was damaged",
-            Error::ImageInvalid => "the image does not hold a consistent world",
-            Error::ImageMismatch => "the image holds a world of another size or layout than this one",
+        match self.c_message().to_str() {
+            Ok(text) => text,
+            // Every message above is an ASCII literal.
+            Err(_) => "",
         }
     }
 }
@@ -155,3 +195,29 @@ impl fmt::Display for Error {
 }
 
 impl core::error::Error for Error {}
+
+// Every message is UTF-8, so `message` never falls back to "".
+const _: () = {
+    let mut i = 0;
+    while i < Error::ALL.len() {
+        assert!(Error::ALL[i].c_message().to_str().is_ok());
+        i += 1;
+    }
+};
+
+#[cfg(test)]
+mod tests {
+    use super::Error;
+
+    #[test]
+    fn numbers_and_messages_are_distinct() {
+        for (i, a) in Error::ALL.iter().enumerate() {
+            assert!(!a.message().is_empty(), "{a:?} has no message");
+            assert_eq!(a.c_message().to_bytes(), a.message().as_bytes());
+            for b in &Error::ALL[..i] {
+                assert_ne!(a.code(), b.code(), "{a:?} and {b:?} share a number");
+                assert_ne!(a.message(), b.message(), "{a:?} and {b:?} share a message");
+            }
+        }
+    }
+}

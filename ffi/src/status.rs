@@ -129,114 +129,92 @@ pub enum mpca_status {
     Unknown = 199,
 }
 
-impl From<Error> for mpca_status {
-    fn from(e: Error) -> Self {
-        use mpca_status as S;
-        match e {
-            Error::BadDimension => S::BadDimension,
-            Error::Dim3Disabled => S::Dim3Disabled,
-            Error::SizeZero => S::SizeZero,
-            Error::SizeOdd => S::SizeOdd,
-            Error::TooLarge => S::TooLarge,
-            Error::PeriodicMismatch => S::PeriodicMismatch,
-            Error::NotFinite => S::NotFinite,
-            Error::NegativeDt => S::NegativeDt,
-            Error::BadVortex => S::BadVortex,
-            Error::BadDrag => S::BadDrag,
-            Error::RestitutionRange => S::RestitutionRange,
-            Error::MassRange => S::MassRange,
-            Error::SpeedRange => S::SpeedRange,
-            Error::Q16Disabled => S::Q16Disabled,
-            Error::FeatureDisabled => S::FeatureDisabled,
-            Error::NotEnabled => S::NotEnabled,
-            Error::CapacityRange => S::CapacityRange,
-            Error::BufferTooSmall => S::BufferTooSmall,
-            Error::OutOfBounds => S::OutOfBounds,
-            Error::CellOccupied => S::CellOccupied,
-            Error::CellObstacle => S::CellObstacle,
-            Error::NoParticle => S::NoParticle,
-            Error::MassTableFull => S::MassTableFull,
-            Error::SurfaceTableFull => S::SurfaceTableFull,
-            Error::UndefinedNormal => S::UndefinedNormal,
-            Error::EmitterTableFull => S::EmitterTableFull,
-            Error::BadEmitter => S::BadEmitter,
-            Error::LifetimeRange => S::LifetimeRange,
-            Error::BadShape => S::BadShape,
-            Error::BadResolution => S::BadResolution,
-            Error::BadLength => S::BadLength,
-            Error::NotAWorld => S::BadHandle,
-            Error::NotOwned => S::NotOwned,
-            Error::OutOfMemory => S::OutOfMemory,
-            Error::OutputTooSmall => S::OutputTooSmall,
-            Error::NotAnImage => S::NotAnImage,
-            Error::ImageVersion => S::ImageVersion,
-            Error::ImageLength => S::ImageLength,
-            Error::ImageChecksum => S::ImageChecksum,
-            Error::ImageInvalid => S::ImageInvalid,
-            Error::ImageMismatch => S::ImageMismatch,
-            _ => S::Unknown,
+impl mpca_status {
+    /// The status of a core error: the one with its number. Every error has
+    /// one (the check below runs this for each at compile time), so the
+    /// panic cannot happen at run time, and no error hides behind `Unknown`.
+    pub(crate) const fn of_error(e: Error) -> Self {
+        match status_from_u32(e.code()) {
+            Some(s) => s,
+            None => panic!("a core error has no mpca_status of its number"),
         }
+    }
+
+    /// The core error this status stands for, if it is one.
+    const fn core_error(self) -> Option<Error> {
+        let mut i = 0;
+        while i < Error::ALL.len() {
+            if Error::ALL[i].code() == self as u32 {
+                return Some(Error::ALL[i]);
+            }
+            i += 1;
+        }
+        None
     }
 }
 
+impl From<Error> for mpca_status {
+    fn from(e: Error) -> Self {
+        Self::of_error(e)
+    }
+}
+
+/// Whether two C strings hold the same bytes, at compile time.
+const fn same_text(a: &CStr, b: &CStr) -> bool {
+    let (a, b) = (a.to_bytes(), b.to_bytes());
+    if a.len() != b.len() {
+        return false;
+    }
+    let mut i = 0;
+    while i < a.len() {
+        if a[i] != b[i] {
+            return false;
+        }
+        i += 1;
+    }
+    true
+}
+
+// Every core error has the status of its number, with core's message (so no
+// error lands on an ABI status that says something else), and every status
+// this file says is a core error's (the long arm of `message`) is one.
+const _: () = {
+    let mut i = 0;
+    while i < Error::ALL.len() {
+        let e = Error::ALL[i];
+        assert!(same_text(mpca_status::of_error(e).message(), e.c_message()));
+        i += 1;
+    }
+    let mut i = 0;
+    while i < ALL.len() {
+        let _ = ALL[i].message();
+        i += 1;
+    }
+};
+
 impl mpca_status {
-    /// The message, as a static C string.
-    pub(crate) fn message(self) -> &'static CStr {
+    /// The message, as a static C string: core's for the statuses of core
+    /// errors, this file's for the ABI's own.
+    pub(crate) const fn message(self) -> &'static CStr {
         use mpca_status as S;
         match self {
             S::Ok => c"success",
             S::NullPointer => c"a pointer argument was NULL",
-            S::BadHandle => c"the world handle is not a live world",
             S::Panic => c"mpca panicked (a bug); destroy the world",
             S::BadStructSize => c"struct_size does not match this library's structure",
             S::BadEnum => c"an enumeration or flag field holds an unknown value",
-            S::OutputTooSmall => c"the output buffer is too small; the count needed was written",
             S::NotASurface => c"the cell is not an obstacle surface cell",
             S::Busy => c"the world is in a parallel step; only its tasks may run until it returns",
             S::StaleTask => c"the ticket is not the parallel step in flight on this world",
             S::TaskIndex => c"the task index is not below the step's task count",
             S::TaskDone => c"this task of the step was run already",
             S::Overlap => c"an image overlaps the memory of the world it is saved from, loaded into or built in",
-            S::BadDimension => c"dimension must be 2 or 3",
-            S::Dim3Disabled => c"3D worlds are not built into this library",
-            S::SizeZero => c"a world size is zero",
-            S::SizeOdd => c"a world size is odd; Margolus blocks need even sizes",
-            S::TooLarge => c"the world is too large for this target",
-            S::PeriodicMismatch => c"periodic boundaries must be set on both faces of an axis",
-            S::NotFinite => c"a floating-point input is NaN or infinite",
-            S::NegativeDt => c"the time step must not be negative",
-            S::BadVortex => c"the vortex core radius must be greater than zero",
-            S::BadDrag => c"the flow drag rate must not be negative",
-            S::RestitutionRange => c"a restitution lies outside [0, 1]",
-            S::MassRange => c"a mass must be greater than zero",
-            S::SpeedRange => c"a speed must not exceed 1 cell per step",
-            S::Q16Disabled => c"16-bit velocities are not built into this library",
-            S::FeatureDisabled => c"the description uses a part this library was built without",
-            S::NotEnabled => c"the world was created without this part",
-            S::CapacityRange => c"a capacity is out of range",
-            S::BufferTooSmall => c"the memory is smaller than mpca_world_bytes asked for",
-            S::OutOfBounds => c"a position lies outside the world",
-            S::CellOccupied => c"the cell already holds a particle",
-            S::CellObstacle => c"the cell is an obstacle",
-            S::NoParticle => c"the cell holds no particle",
-            S::MassTableFull => c"the table of distinct masses is full",
-            S::SurfaceTableFull => c"the obstacle surface table is full",
-            S::UndefinedNormal => c"an obstacle surface cell would have no defined normal",
-            S::EmitterTableFull => c"the emitter table is full",
-            S::BadEmitter => c"an emitter region is empty or reversed, or its rate is negative",
-            S::LifetimeRange => c"a lifetime is longer than 65535 steps",
-            S::BadShape => c"a shape is degenerate",
-            S::BadResolution => c"the output resolution or buffer length is wrong",
-            S::BadLength => c"a per-cell input has the wrong length, or a length exceeds PTRDIFF_MAX bytes",
-            S::NotOwned => c"the world lives in caller memory: deinit it and free the memory yourself",
-            S::OutOfMemory => c"the allocator refused the memory",
-            S::NotAnImage => c"the bytes are not an mpca world image",
-            S::ImageVersion => c"the image is of a format version this library does not read",
-            S::ImageLength => c"the image is shorter or longer than its header says",
-            S::ImageChecksum => c"the image's checksum does not match: it was damaged",
-            S::ImageInvalid => c"the image does not hold a consistent world",
-            S::ImageMismatch => c"the image holds a world of another size or layout than this one",
             S::Unknown => c"an error this version of the C ABI does not name",
+            // The statuses of core errors say what core says.
+            S::BadHandle | S::OutputTooSmall | S::BadDimension | S::Dim3Disabled | S::SizeZero | S::SizeOdd | S::TooLarge | S::PeriodicMismatch | S::NotFinite | S::NegativeDt | S::BadVortex | S::BadDrag | S::RestitutionRange | S::MassRange | S::SpeedRange | S::Q16Disabled | S::FeatureDisabled | S::NotEnabled | S::CapacityRange | S::BufferTooSmall | S::OutOfBounds | S::CellOccupied | S::CellObstacle | S::NoParticle | S::MassTableFull | S::SurfaceTableFull | S::UndefinedNormal | S::EmitterTableFull | S::BadEmitter | S::LifetimeRange | S::BadShape | S::BadResolution | S::BadLength | S::NotOwned | S::OutOfMemory | S::NotAnImage | S::ImageVersion | S::ImageLength | S::ImageChecksum | S::ImageInvalid | S::ImageMismatch => match self.core_error() {
+                Some(e) => e.c_message(),
+                None => panic!("a status listed as a core error's has no core error"),
+            },
         }
     }
 }
@@ -251,10 +229,10 @@ pub extern "C" fn mpca_status_message(status: u32) -> *const c_char {
     }
 }
 
-/// The status numbered `n`, if there is one.
-pub(crate) fn status_from_u32(n: u32) -> Option<mpca_status> {
+/// Every status, for looking one up by number.
+const ALL: [mpca_status; 53] = {
     use mpca_status as S;
-    const ALL: [mpca_status; 53] = [
+    [
         S::Ok, S::NullPointer, S::BadHandle, S::Panic, S::BadStructSize, S::BadEnum, S::OutputTooSmall, S::NotASurface,
         S::Busy, S::StaleTask, S::TaskIndex, S::TaskDone, S::Overlap,
         S::BadDimension, S::Dim3Disabled, S::SizeZero, S::SizeOdd, S::TooLarge, S::PeriodicMismatch,
@@ -264,6 +242,17 @@ pub(crate) fn status_from_u32(n: u32) -> Option<mpca_status> {
         S::SurfaceTableFull, S::UndefinedNormal, S::EmitterTableFull, S::BadEmitter, S::LifetimeRange,
         S::BadShape, S::BadResolution, S::BadLength, S::NotOwned, S::OutOfMemory,
         S::NotAnImage, S::ImageVersion, S::ImageLength, S::ImageChecksum, S::ImageInvalid, S::ImageMismatch, S::Unknown,
-    ];
-    ALL.iter().copied().find(|s| *s as u32 == n)
+    ]
+};
+
+/// The status numbered `n`, if there is one.
+pub(crate) const fn status_from_u32(n: u32) -> Option<mpca_status> {
+    let mut i = 0;
+    while i < ALL.len() {
+        if ALL[i] as u32 == n {
+            return Some(ALL[i]);
+        }
+        i += 1;
+    }
+    None
 }
