@@ -148,3 +148,12 @@ void check_status(mpca_status got, mpca_status want, const char *what, const cha
 unsigned check_failures(void) {
     return failures;
 }
+
+uint32_t check_random(uint64_t *state) {
+    *state = *state * 6364136223846793005ull + 1442695040888963407ull;
+    return (uint32_t)(*state >> 33);
+}
+
+float check_unit(uint64_t *state) {
+    return (float)(check_random(state) >> 8) / 16777216.0f;
+}

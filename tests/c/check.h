@@ -52,4 +52,9 @@ void check_status(mpca_status got, mpca_status want, const char *what, const cha
 /* The number of failed checks so far. */
 unsigned check_failures(void);
 
+/* A small deterministic generator (a 64-bit LCG, its high bits) for placing
+ * particles: the next 31-bit value, and a float uniform in [0, 1). */
+uint32_t check_random(uint64_t *state);
+float check_unit(uint64_t *state);
+
 #endif /* MPCA_TEST_CHECK_H */

@@ -24,17 +24,6 @@
 
 #include "check.h"
 
-/* ---- A small deterministic generator for placing particles ------------ */
-
-static uint32_t next(uint64_t *s) {
-    *s = *s * 6364136223846793005ull + 1442695040888963407ull;
-    return (uint32_t)(*s >> 33);
-}
-
-static float unit(uint64_t *s) {
-    return (float)(next(s) >> 8) / 16777216.0f;
-}
-
 /* ---- The worlds -------------------------------------------------------- */
 
 enum kind { GAS_2D, BOX_2D, SPHERE_3D, EMITTER_2D, GAS_1024, KINDS };
@@ -107,11 +96,11 @@ static mpca_world *build(enum kind kind) {
         for (z = 0; z < nz; z++) {
             for (y = 0; y < n; y++) {
                 for (x = 0; x < n; x++) {
-                    if (unit(&s) < density) {
+                    if (check_unit(&s) < density) {
                         uint32_t pos[3] = {x, y, z};
-                        float v[3] = {0.6f * (unit(&s) - 0.5f), 0.6f * (unit(&s) - 0.5f), 0};
+                        float v[3] = {0.6f * (check_unit(&s) - 0.5f), 0.6f * (check_unit(&s) - 0.5f), 0};
                         if (dim == 3) {
-                            v[2] = 0.6f * (unit(&s) - 0.5f);
+                            v[2] = 0.6f * (check_unit(&s) - 0.5f);
                         }
                         /* Obstacle cells refuse; that is fine. */
                         (void)mpca_world_add_particle(w, pos, v);
@@ -189,7 +178,7 @@ static void run_tasks(mpca_world *world, uint64_t ticket, uint32_t count, void *
     }
     if (h->order == SHUFFLED) {
         for (i = count; i > 1; i--) {
-            uint32_t j = next(&h->shuffle) % i, tmp = order[i - 1];
+            uint32_t j = check_random(&h->shuffle) % i, tmp = order[i - 1];
             order[i - 1] = order[j];
             order[j] = tmp;
         }

@@ -117,12 +117,6 @@ static uint64_t fingerprint(void) {
 
 /* --- The worlds ------------------------------------------------------------ */
 
-/* A small generator for placing particles. */
-static uint32_t next(uint64_t *s) {
-    *s = *s * 6364136223846793005ull + 1442695040888963407ull;
-    return (uint32_t)(*s >> 33);
-}
-
 /* 2D, 24 x 24: 16-bit velocities, per-particle masses, lifetimes, a disc,
  * an emitter, gravity and the vortex, open and wall faces. */
 static void desc_2d(mpca_desc *d) {
@@ -167,7 +161,7 @@ static void fill_2d(mpca_world *w) {
     uint64_t s = 11;
     for (uint32_t y = 0; y < 24; y++) {
         for (uint32_t x = 0; x < 24; x++) {
-            uint32_t r = next(&s);
+            uint32_t r = check_random(&s);
             mpca_cell c;
             uint32_t pos[3] = {x, y, 0};
             CHECK_OK(mpca_world_cell(w, pos, &c));
@@ -200,7 +194,7 @@ static void fill_3d(mpca_world *w) {
     for (uint32_t z = 0; z < 12; z++) {
         for (uint32_t y = 7; y < 11; y++) {
             for (uint32_t x = 0; x < 12; x++) {
-                uint32_t r = next(&s);
+                uint32_t r = check_random(&s);
                 uint32_t pos[3] = {x, y, z};
                 if (r % 3 == 0) {
                     float v[3] = {(float)(r % 7) * 0.05f - 0.15f, -0.1f, (float)((r >> 4) % 7) * 0.05f - 0.15f};
