@@ -62,6 +62,22 @@ pub(crate) fn block_pairs<const D: usize>() -> &'static [(u8, u8)] {
     if D == 2 { &PAIRS_2D } else { &PAIRS_3D }
 }
 
+/// M5.2's pair of a block with occupancy `occ`: one of the block's pairs,
+/// uniformly (16 bits of the stream, drawn only where the block holds two
+/// particles or more); its two cells where both hold a particle.
+#[inline]
+pub(crate) fn pick_pair<const D: usize>(occ: u8, rng: &mut Stream) -> Option<(usize, usize)> {
+    if occ & occ.wrapping_sub(1) == 0 {
+        return None;
+    }
+    let pairs = block_pairs::<D>();
+    let p = rng.below(pairs.len() as u32);
+    pair_holds_two::<D>(occ, p).then(|| {
+        let (a, c) = pairs[p as usize];
+        (usize::from(a), usize::from(c))
+    })
+}
+
 /// A uniformly random unit vector (the `R` of eqs. 7-8): uniform on the
 /// circle in 2D, on the sphere in 3D, the third component 0 in 2D.
 ///

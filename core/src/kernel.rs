@@ -38,7 +38,7 @@
 
 use crate::assign::{assign_moves, optimal_moves_2d, pick_move, Method, MoveProblem, PLACE_2D};
 use crate::cells::Cells;
-use crate::collision::{block_pairs, collide_limited, collide_pair, energy_neutral, pair_holds_two, random_unit, shares};
+use crate::collision::{collide_limited, collide_pair, energy_neutral, pick_pair, random_unit, shares};
 use crate::desc::{Collisions, Description, Vortex};
 use crate::force::{vortex_force, ForceTerms};
 use crate::obstacle::{reflect, surface_at, Surface};
@@ -335,23 +335,24 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
     }
 
     /// M5.2: one of the block's pairs, uniformly; if both its cells hold a
-    /// particle, eqs. 7-8 with `R` uniform, then the clamp. `mass` gives a
-    /// cell's mass; `equal` says every mass is the same.
+    /// particle, [`Kernel::collide_two`]. `mass` gives a cell's mass;
+    /// `equal` says every mass is the same.
     #[inline(always)]
     fn collide(&mut self, b: &mut Block<D, CELLS>, rng: &mut Stream, mass: impl Fn(usize) -> f32, equal: bool) {
-        if b.occ & (b.occ - 1) == 0 {
-            return;
+        if let Some((a, c)) = pick_pair::<D>(b.occ, rng) {
+            let (xa, xc) = self.collide_two(b.velocity(a), b.velocity(c), (mass(a), mass(c)), equal, rng);
+            b.set(a, xa);
+            b.set(c, xc);
         }
-        let pairs = block_pairs::<D>();
-        let p = rng.below(pairs.len() as u32);
-        if !pair_holds_two::<D>(b.occ, p) {
-            return;
-        }
-        let (a, c) = pairs[p as usize];
-        let (a, c) = (usize::from(a), usize::from(c));
-        let (ma, mc) = (mass(a), mass(c));
+    }
+
+    /// M5.2 on two particles of masses `(ma, mc)` with velocities `va`, `vc`
+    /// in quanta: eqs. 7-8 with `R` uniform (or M5.2b), M1b when on, then
+    /// the clamp of both; counts the collision.
+    #[inline(always)]
+    fn collide_two(&mut self, va: [f32; 3], vc: [f32; 3], (ma, mc): (f32, f32), equal: bool, rng: &mut Stream) -> ([f32; 3], [f32; 3]) {
         let s = if equal { (0.5, 0.5) } else { shares(ma, mc) };
-        let (va, vc, e) = (b.velocity(a), b.velocity(c), self.shared.desc.restitution);
+        let e = self.shared.desc.restitution;
         let (mut xa, mut xc) = match self.shared.desc.collisions {
             Collisions::Paper => collide_pair(va, vc, s, e, random_unit::<D>(rng)),
             // Below the limit by sqrt(D) quanta, so that rounding (less than a
@@ -364,8 +365,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
         self.counters.collisions += 1;
         clamp_counted(&mut xa, Q::SCALE, ma, &mut self.counters);
         clamp_counted(&mut xc, Q::SCALE, mc, &mut self.counters);
-        b.set(a, xa);
-        b.set(c, xc);
+        (xa, xc)
     }
 
     /// M5.3: the axes the particle in cell `c` wants to cross, from its
@@ -373,8 +373,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
     /// be wanted: towards +k from the low side of the block, towards -k from
     /// the high.
     #[inline(always)]
-    fn decide(&self, b: &Block<D, CELLS>, c: usize, rng: &mut Stream) -> u8 {
-        let q = b.v[c];
+    fn decide(&self, q: [i32; D], c: usize, rng: &mut Stream) -> u8 {
         let mut inward = 0u8;
         for k in 0..D {
             let low = (c >> k) & 1 == 0;
@@ -431,15 +430,15 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
     /// M5.4 has turned such a wish into staying), `wanted` their union;
     /// `key` is the 2D table key.
     #[inline(always)]
-    fn assign(&mut self, b: &Block<D, CELLS>, blocked: u8, want: &[u8; CELLS], wanted: u8, key: usize, rng: &mut Stream) -> u32 {
+    fn assign(&mut self, occ: u8, speed2: impl Fn(usize) -> f32, blocked: u8, want: &[u8; CELLS], wanted: u8, key: usize, rng: &mut Stream) -> u32 {
         // Where nobody wants to move, or the block holds one particle, the
         // optimum is unique (everyone stays; the particle takes the free cell
         // it wants) and no method draws for it: take it directly.
         if wanted == 0 {
             return IDENTITY;
         }
-        if b.occ & (b.occ - 1) == 0 {
-            let c = b.occ.trailing_zeros() as usize;
+        if occ & (occ - 1) == 0 {
+            let c = occ.trailing_zeros() as usize;
             return IDENTITY ^ u32::from(want[c]) << (4 * c);
         }
         let method = self.shared.desc.method;
@@ -449,13 +448,12 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
             // 2 bits a cell in the table; 4 here, as in 3D.
             return SPREAD_2D[usize::from(packed as u8)];
         }
-        let mut problem = MoveProblem { free: !blocked & Self::ALL, count: b.occ.count_ones() as usize, ..MoveProblem::default() };
-        for (i, c) in cells_of(b.occ).enumerate() {
+        let mut problem = MoveProblem { free: !blocked & Self::ALL, count: occ.count_ones() as usize, ..MoveProblem::default() };
+        for (i, c) in cells_of(occ).enumerate() {
             problem.current[i] = c as u8;
             problem.desired[i] = c as u8 ^ want[c];
             if method == Method::Greedy {
-                let x = b.velocity(c);
-                problem.speed2[i] = dot(x, x);
+                problem.speed2[i] = speed2(c);
             }
         }
         let moves = assign_moves::<D>(method, &problem, rng);
@@ -542,14 +540,14 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
         let (mut key, mut wanted) = (0, 0u8);
         each_cell!(CELLS, c => {
             if occ >> c & 1 != 0 {
-                want[c] = self.decide(&b, c, &mut rng);
+                want[c] = self.decide(b.v[c], c, &mut rng);
                 wanted |= want[c];
                 if D == 2 {
                     key += usize::from(PLACE_2D[c & 3]) * usize::from(2 + want[c]);
                 }
             }
         });
-        let targets = self.assign(&b, 0, &want, wanted, key, &mut rng);
+        let targets = self.assign(occ, |c| { let x = b.velocity(c); dot(x, x) }, 0, &want, wanted, key, &mut rng);
         if sh.desc.contacts && wanted != 0 {
             self.contacts(&mut b, &want, targets, |_| mass, true);
             b.round::<Q>(&mut rng);
@@ -570,6 +568,100 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
             }
         });
         self.occupy(row, xs, occ, after);
+    }
+
+    /// [`Kernel::lean`] for a 2D block whose two cells of each row are
+    /// neighbours in one occupancy word (`x0 % 64 != 63`, no wrap), in a
+    /// world without contacts: the velocities stay as stored until a stage
+    /// changes them, and the occupancy is rewritten a block row (two bits)
+    /// at a time. The same draws in the same order, so the same world.
+    #[inline(always)]
+    fn lean_2d(&mut self, row: &BlockRow, x0: usize, index: u64, occ: u8) {
+        let sh = self.shared;
+        let mass = sh.desc.mass;
+        let velocity = self.planes.velocity;
+        let mut v = [[Q::default(); D]; CELLS];
+        for r in 0..2 {
+            if occ >> (2 * r) & 3 != 0 {
+                [v[2 * r], v[2 * r + 1]] = velocity.pair(x0 + row.cell[r]);
+            }
+        }
+        let quanta = |q: [Q; D]| {
+            let mut x = [0.0f32; 3];
+            for k in 0..D {
+                x[k] = q[k].to_int() as f32;
+            }
+            x
+        };
+        let mut rng = sh.key.stream(index);
+
+        // M5.1 and M5.2 leave their velocities in `x`, in quanta, marked in
+        // `pending`; M1 rounds them back.
+        let mut x = [[0.0f32; 3]; CELLS];
+        let mut pending = 0u8;
+        if let Some(dv) = sh.push {
+            for c in cells_of(occ) {
+                let mut y = quanta(v[c]);
+                for k in 0..D {
+                    y[k] += dv[k];
+                }
+                clamp_counted(&mut y, Q::SCALE, mass, &mut self.counters);
+                x[c] = y;
+            }
+            pending = occ;
+        }
+        if let Some((a, c)) = pick_pair::<D>(occ, &mut rng) {
+            let get = |c: usize| if pending >> c & 1 != 0 { x[c] } else { quanta(v[c]) };
+            (x[a], x[c]) = self.collide_two(get(a), get(c), (mass, mass), true, &mut rng);
+            pending |= 1 << a | 1 << c;
+        }
+        for c in cells_of(pending) {
+            v[c] = Q::round::<D>(x[c], &mut rng).map(Q::from_int);
+        }
+
+        // M5.3, then M5.6.
+        let mut want = [0u8; CELLS];
+        let (mut key, mut wanted) = (0, 0u8);
+        each_cell!(CELLS, c => {
+            if occ >> c & 1 != 0 {
+                want[c] = self.decide(v[c].map(Q::to_int), c, &mut rng);
+                wanted |= want[c];
+                key += usize::from(PLACE_2D[c & 3]) * usize::from(2 + want[c]);
+            }
+        });
+        let targets = self.assign(occ, |c| { let x = quanta(v[c]); dot(x, x) }, 0, &want, wanted, key, &mut rng);
+
+        self.counters.processed += 1;
+        let moved = (targets ^ IDENTITY) & FIELDS[usize::from(occ)] != 0;
+        if !moved && pending == 0 {
+            return;
+        }
+        let mut after = 0u8;
+        each_cell!(CELLS, c => {
+            if occ >> c & 1 != 0 {
+                let t = (targets >> (4 * c) & 7) as usize;
+                after |= 1 << t;
+                if t != c || pending >> c & 1 != 0 {
+                    velocity.set(x0 + (t & 1) + row.cell[t >> 1], v[c]);
+                }
+            }
+        });
+        if moved {
+            let shift = x0 & 63;
+            for r in 0..2 {
+                let (old, new) = (u64::from(occ >> (2 * r) & 3), u64::from(after >> (2 * r) & 3));
+                if old != new {
+                    let at = row.word[r] + (x0 >> 6);
+                    let w = self.planes.occupancy.get(at);
+                    self.planes.occupancy.set(at, w & !(3 << shift) | new << shift);
+                    // A row that held no particle of the block may have been
+                    // swept as empty: flag it again (M3).
+                    if old == 0 {
+                        mark(self.planes.rows, self.planes.words, sh.part.summary_words, row.line[r], x0);
+                    }
+                }
+            }
+        }
     }
 
     /// The local map of M5 on any block: the half blocks on faces that are
@@ -664,7 +756,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
         let mut wanted = 0u8;
         let mut key = if D == 2 { usize::from(BLOCKED_KEY_2D[usize::from(blocked & 15)]) } else { 0 };
         for c in cells_of(occ) {
-            let mut m = self.decide(&b, c, &mut rng);
+            let mut m = self.decide(b.v[c], c, &mut rng);
             let t = c ^ usize::from(m);
             if m != 0 && blocked >> t & 1 != 0 {
                 let to = Wanted { cell: t, site: cell(t), at: at(t), wall: wall >> t & 1 != 0 };
@@ -679,7 +771,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
         }
 
         // M5.6 move.
-        let targets = self.assign(&b, blocked, &want, wanted, key, &mut rng);
+        let targets = self.assign(occ, |c| { let x = b.velocity(c); dot(x, x) }, blocked, &want, wanted, key, &mut rng);
 
         // M5.7 contacts, then M1 for what they changed.
         if desc.contacts && wanted != 0 {
@@ -730,6 +822,12 @@ impl<'a, Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Bloc
         let sh = self.shared;
         if !GENERAL && sh.plain && row.outside == 0 && x0 >= 0 {
             let x0 = x0 as usize;
+            if D == 2 && !sh.desc.contacts && x0 & 63 != 63 && x0 + 1 < sh.n[0] {
+                if !sh.desc.obstacles || read_block::<CELLS>(sh.obstacle, row, [x0, x0 + 1]) == 0 {
+                    return self.lean_2d(row, x0, row.index + bx as u64, occ);
+                }
+                return self.general(row, x0 as isize, bx, occ);
+            }
             let x1 = if x0 + 1 < sh.n[0] { Some(x0 + 1) } else { sh.part.axes[0].periodic.then_some(0) };
             if let Some(x1) = x1 {
                 // A world with obstacles: only blocks without one are lean.
