@@ -15,24 +15,27 @@
 //! [`Kernel::lean`] is the same routine for the common case, blocks of a
 //! plain world (one mass, no lifetimes, at most a uniform force) away from
 //! the faces and without an obstacle, without the code for what such a
-//! block cannot hold; [`Kernel::general`] handles everything. Both draw the same
-//! numbers in the same order, so they give the same world bit for bit, and
-//! the tests hold them to it.
+//! block cannot hold; [`Kernel::lean_2d`] is the 2D 8-bit case of it, which
+//! reads a block's velocities as one word of byte lanes. [`Kernel::general`]
+//! handles everything. All three draw the same numbers in the same order,
+//! so they give the same world bit for bit, and the tests hold them to it.
 //!
 //! Every draw of a block comes from its stream (M8), in this order:
 //! 1. M5.2, if the block holds two particles or more, the pair (16 bits);
-//!    if both cells of the pair hold one, the unit vector `R` (32 or 48
-//!    bits a try);
+//!    if both cells of the pair hold one and their velocities differ, the
+//!    unit vector `R` (32 or 48 bits a try);
 //! 2. M1, per particle in cell order whose velocity the force or the
-//!    collision changed, one 64-bit output for its rounding (16 bits a
-//!    component);
-//! 3. M5.3 and M5.4, per particle in cell order that could move inside the
-//!    block along some axis, 16 bits per axis (32 bits, then 16 in 3D), and
-//!    after a reflection one 64-bit output for rounding the reflected
-//!    velocity;
+//!    collision changed, its rounding (16 bits a component: 32 bits in 2D,
+//!    a 64-bit output in 3D);
+//! 3. M5.3 and M5.4: in 3D, per particle in cell order that could move
+//!    inside the block along some axis, 16 bits per axis (32, then 16); in
+//!    2D, at the first such particle one 64-bit output (a byte per cell and
+//!    axis), then in cell and axis order 8 bits per axis whose byte ties
+//!    with its threshold's ([`Kernel::decide`]); after a reflection, the
+//!    reflected velocity's rounding;
 //! 4. M5.6, the tie-break of the assignment, where there is a choice;
 //! 5. M1 after M5.7's contacts (when on), per particle in cell order whose
-//!    velocity a contact changed, one 64-bit output for its rounding.
+//!    velocity a contact changed, its rounding.
 //!
 //! M5.1 draws nothing.
 
@@ -154,6 +157,88 @@ const SPREAD_2D: [u32; 256] = {
     }
     t
 };
+
+/// Per 2D occupancy mask, the part of the move table's key (M5.6) that
+/// the occupied cells give whatever they want (digit 2 each).
+const KEY_2D_OCCUPIED: [u16; 16] = {
+    let mut t = [0; 16];
+    let mut mask = 0;
+    while mask < 16 {
+        let mut c = 0;
+        while c < 4 {
+            if mask >> c & 1 != 0 {
+                t[mask] += 2 * PLACE_2D[c];
+            }
+            c += 1;
+        }
+        mask += 1;
+    }
+    t
+};
+
+/// Per 2D wish byte (bits `2c, 2c + 1`: the axes cell `c` wants to cross),
+/// the rest of the key: digit `2 + m` for a particle that wants `c ^ m`.
+const KEY_2D_WANTS: [u16; 256] = {
+    let mut t = [0; 256];
+    let mut w = 0;
+    while w < 256 {
+        let mut c = 0;
+        while c < 4 {
+            t[w] += PLACE_2D[c] * ((w >> (2 * c)) & 3) as u16;
+            c += 1;
+        }
+        w += 1;
+    }
+    t
+};
+
+/// Per 2D occupancy mask, `0xffff` in the two byte lanes of each occupied
+/// cell.
+const LANES_2D: [u64; 16] = {
+    let mut t = [0; 16];
+    let mut mask = 0;
+    while mask < 16 {
+        let mut c = 0;
+        while c < 4 {
+            if mask >> c & 1 != 0 {
+                t[mask] |= 0xffff << (16 * c);
+            }
+            c += 1;
+        }
+        mask += 1;
+    }
+    t
+};
+
+/// The high bit of each byte lane `2c + k` where cell `c` lies on the high
+/// side of axis `k` (its inward direction is negative).
+const HIGH_SIDE_2D: u64 = {
+    let mut m = 0u64;
+    let mut i = 0;
+    while i < 8 {
+        let (c, k) = (i / 2, i % 2);
+        if (c >> k) & 1 != 0 {
+            m |= 0x80 << (8 * i);
+        }
+        i += 1;
+    }
+    m
+};
+
+/// M5.3's first test for a whole 2D block of 8-bit velocities in byte
+/// lanes (lane `2c + k`: cell `c`'s component `k`): bit `2c + k` set where
+/// cell `c` is occupied and its component `k` points inward (positive on
+/// the block's low side of the axis, negative on the high side).
+#[inline(always)]
+fn inward_lanes(lanes: u64, occ: u8) -> u8 {
+    const HIGH: u64 = 0x8080_8080_8080_8080;
+    const LOW: u64 = 0x7f7f_7f7f_7f7f_7f7f;
+    // The high bit of each lane: set where the lane is not 0.
+    let nonzero = ((lanes & LOW) + LOW | lanes) & HIGH;
+    let inward = nonzero & !(lanes ^ HIGH_SIDE_2D) & LANES_2D[usize::from(occ & 15)];
+    // Gather the eight high bits into one byte.
+    ((inward >> 7).wrapping_mul(0x0102_0408_1020_4080) >> 56) as u8
+}
 
 /// Runs `$body` once for each cell of a block of `$cells` cells, with `$c`
 /// bound to the cell's number as a constant: every index, side and table
@@ -340,17 +425,25 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
     #[inline(always)]
     fn collide(&mut self, b: &mut Block<D, CELLS>, rng: &mut Stream, mass: impl Fn(usize) -> f32, equal: bool) {
         if let Some((a, c)) = pick_pair::<D>(b.occ, rng) {
-            let (xa, xc) = self.collide_two(b.velocity(a), b.velocity(c), (mass(a), mass(c)), equal, rng);
-            b.set(a, xa);
-            b.set(c, xc);
+            if let Some((xa, xc)) = self.collide_two(b.velocity(a), b.velocity(c), (mass(a), mass(c)), equal, rng) {
+                b.set(a, xa);
+                b.set(c, xc);
+            }
         }
     }
 
     /// M5.2 on two particles of masses `(ma, mc)` with velocities `va`, `vc`
     /// in quanta: eqs. 7-8 with `R` uniform (or M5.2b), M1b when on, then
-    /// the clamp of both; counts the collision.
+    /// the clamp of both; counts the collision. `None` where the collision
+    /// changes neither velocity, whatever `R`: two equal velocities within the
+    /// speed limit (eqs. 7-8 give both the centre-of-mass velocity, which is
+    /// theirs), so a pair at rest draws nothing for it.
     #[inline(always)]
-    fn collide_two(&mut self, va: [f32; 3], vc: [f32; 3], (ma, mc): (f32, f32), equal: bool, rng: &mut Stream) -> ([f32; 3], [f32; 3]) {
+    fn collide_two(&mut self, va: [f32; 3], vc: [f32; 3], (ma, mc): (f32, f32), equal: bool, rng: &mut Stream) -> Option<([f32; 3], [f32; 3])> {
+        self.counters.collisions += 1;
+        if va == vc && dot(va, va) <= Q::SCALE * Q::SCALE {
+            return None;
+        }
         let s = if equal { (0.5, 0.5) } else { shares(ma, mc) };
         let e = self.shared.desc.restitution;
         let (mut xa, mut xc) = match self.shared.desc.collisions {
@@ -362,18 +455,25 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
         if self.shared.desc.energy_neutral {
             (xa, xc) = energy_neutral(xa, xc, s);
         }
-        self.counters.collisions += 1;
         clamp_counted(&mut xa, Q::SCALE, ma, &mut self.counters);
         clamp_counted(&mut xc, Q::SCALE, mc, &mut self.counters);
-        (xa, xc)
+        Some((xa, xc))
     }
 
     /// M5.3: the axes the particle in cell `c` wants to cross, from its
-    /// stored (rounded) velocity. Only a move that stays inside the block can
-    /// be wanted: towards +k from the low side of the block, towards -k from
-    /// the high.
+    /// stored (rounded) velocity `q`. Only a move that stays inside the block
+    /// can be wanted: towards +k from the low side of the block, towards -k
+    /// from the high.
+    ///
+    /// In 2D, `bytes` is one 64-bit output of the stream, drawn by the
+    /// block's first particle that wants to cross an axis: byte `2c + k`
+    /// holds the high 8 of the 16 random bits for cell `c`'s axis `k`, and
+    /// the low 8 come from the stream only where the high 8 alone cannot
+    /// decide (they equal the limit's high 8: one case in 256). The decision
+    /// is that of 16 uniform bits, drawn without bookkeeping for most axes.
+    /// In 3D, 16 bits an axis come from the stream (48 a particle).
     #[inline(always)]
-    fn decide(&self, q: [i32; D], c: usize, rng: &mut Stream) -> u8 {
+    fn decide(&self, q: [i32; D], c: usize, bytes: &mut Option<u64>, rng: &mut Stream) -> u8 {
         let mut inward = 0u8;
         for k in 0..D {
             let low = (c >> k) & 1 == 0;
@@ -382,11 +482,23 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
         if inward == 0 {
             return 0;
         }
-        let r = if D == 2 { u64::from(rng.bits(32)) } else { u64::from(rng.bits(32)) | u64::from(rng.bits(16)) << 32 };
         let (table, drift) = (self.shared.moves, self.shared.desc.drift);
         let mut m = 0u8;
+        if D == 2 {
+            let bytes = *bytes.get_or_insert_with(|| rng.next_u64());
+            for k in 0..D {
+                if inward >> k & 1 != 0 {
+                    let limit = Q::move_limit(table, drift, q[k]);
+                    let (high, top) = ((bytes >> (8 * (2 * c + k))) as u8 as u32, limit >> 8);
+                    let moves = high < top || high == top && rng.bits(8) <= limit & 0xff;
+                    m |= u8::from(moves) << k;
+                }
+            }
+            return m;
+        }
+        let r = u64::from(rng.bits(32)) | u64::from(rng.bits(16)) << 32;
         for k in 0..D {
-            m |= u8::from(Q::wants_move(table, drift, q[k], (r >> (16 * k)) as u32 & 0xffff)) << k;
+            m |= u8::from((r >> (16 * k)) as u32 & 0xffff <= Q::move_limit(table, drift, q[k])) << k;
         }
         m & inward
     }
@@ -529,6 +641,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
         let mass = sh.desc.mass;
         let mut b = self.load(row, xs, occ);
         let mut rng = sh.key.stream(index);
+        let mut bytes = None;
         if let Some(dv) = sh.push {
             for c in cells_of(occ) {
                 self.push(&mut b, c, dv, mass);
@@ -540,7 +653,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
         let (mut key, mut wanted) = (0, 0u8);
         each_cell!(CELLS, c => {
             if occ >> c & 1 != 0 {
-                want[c] = self.decide(b.v[c], c, &mut rng);
+                want[c] = self.decide(b.v[c], c, &mut bytes, &mut rng);
                 wanted |= want[c];
                 if D == 2 {
                     key += usize::from(PLACE_2D[c & 3]) * usize::from(2 + want[c]);
@@ -570,66 +683,88 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
         self.occupy(row, xs, occ, after);
     }
 
-    /// [`Kernel::lean`] for a 2D block whose two cells of each row are
-    /// neighbours in one occupancy word (`x0 % 64 != 63`, no wrap), in a
-    /// world without contacts: the velocities stay as stored until a stage
-    /// changes them, and the occupancy is rewritten a block row (two bits)
-    /// at a time. The same draws in the same order, so the same world.
+    /// [`Kernel::lean`] for a 2D block of an 8-bit world whose two cells of
+    /// each row are neighbours in one occupancy word (`x0 % 64 != 63`, no
+    /// wrap), in a world without contacts. The block's stored velocities
+    /// are read as one 64-bit word of byte lanes, lane `2c + k` holding cell
+    /// `c`'s component `k` (two 32-bit reads, one a block row): which
+    /// particles want to cross an axis inward is a handful of word
+    /// operations for the whole block, and only those axes read the move
+    /// table. A velocity a stage changes is rounded back into its lanes.
+    /// The draws are those of [`Kernel::general`], in the same order, so
+    /// the world is the same bit for bit.
     #[inline(always)]
     fn lean_2d(&mut self, row: &BlockRow, x0: usize, index: u64, occ: u8) {
         let sh = self.shared;
         let mass = sh.desc.mass;
         let velocity = self.planes.velocity;
-        let mut v = [[Q::default(); D]; CELLS];
+        let mut lanes = 0u64;
         for r in 0..2 {
             if occ >> (2 * r) & 3 != 0 {
-                [v[2 * r], v[2 * r + 1]] = velocity.pair(x0 + row.cell[r]);
+                lanes |= u64::from(Q::lanes_2d(velocity.pair(x0 + row.cell[r]))) << (32 * r);
             }
         }
-        let quanta = |q: [Q; D]| {
-            let mut x = [0.0f32; 3];
-            for k in 0..D {
-                x[k] = q[k].to_int() as f32;
-            }
-            x
+        let quanta = |lanes: u64, c: usize| {
+            let q = (lanes >> (16 * c)) as u16;
+            [f32::from(q as u8 as i8), f32::from((q >> 8) as u8 as i8), 0.0]
         };
         let mut rng = sh.key.stream(index);
 
         // M5.1 and M5.2 leave their velocities in `x`, in quanta, marked in
-        // `pending`; M1 rounds them back.
+        // `pending`; M1 rounds them back into their lanes.
         let mut x = [[0.0f32; 3]; CELLS];
         let mut pending = 0u8;
         if let Some(dv) = sh.push {
             for c in cells_of(occ) {
-                let mut y = quanta(v[c]);
-                for k in 0..D {
-                    y[k] += dv[k];
-                }
+                let mut y = quanta(lanes, c);
+                y[0] += dv[0];
+                y[1] += dv[1];
                 clamp_counted(&mut y, Q::SCALE, mass, &mut self.counters);
                 x[c] = y;
             }
             pending = occ;
         }
         if let Some((a, c)) = pick_pair::<D>(occ, &mut rng) {
-            let get = |c: usize| if pending >> c & 1 != 0 { x[c] } else { quanta(v[c]) };
-            (x[a], x[c]) = self.collide_two(get(a), get(c), (mass, mass), true, &mut rng);
-            pending |= 1 << a | 1 << c;
+            let get = |c: usize| if pending >> c & 1 != 0 { x[c] } else { quanta(lanes, c) };
+            if let Some(pair) = self.collide_two(get(a), get(c), (mass, mass), true, &mut rng) {
+                (x[a], x[c]) = pair;
+                pending |= 1 << a | 1 << c;
+            }
         }
         for c in cells_of(pending) {
-            v[c] = Q::round::<D>(x[c], &mut rng).map(Q::from_int);
+            let [qx, qy] = Q::round::<2>(x[c], &mut rng).map(|q| u64::from(Q::from_int(q).to_int() as u8));
+            lanes = lanes & !(0xffff << (16 * c)) | (qx | qy << 8) << (16 * c);
         }
 
-        // M5.3, then M5.6.
-        let mut want = [0u8; CELLS];
-        let (mut key, mut wanted) = (0, 0u8);
-        each_cell!(CELLS, c => {
-            if occ >> c & 1 != 0 {
-                want[c] = self.decide(v[c].map(Q::to_int), c, &mut rng);
-                wanted |= want[c];
-                key += usize::from(PLACE_2D[c & 3]) * usize::from(2 + want[c]);
+        // M5.3: the lanes that point inward, then a move table entry for
+        // each of those only ([`Kernel::decide`]'s draws).
+        let mut want = 0u8;
+        let inward = inward_lanes(lanes, occ);
+        if inward != 0 {
+            let bytes = rng.next_u64();
+            let table = sh.moves;
+            let mut todo = inward;
+            while todo != 0 {
+                let i = todo.trailing_zeros();
+                todo &= todo - 1;
+                let limit = u32::from(table[usize::from((lanes >> (8 * i)) as u8)]);
+                let (high, top) = ((bytes >> (8 * i)) as u8 as u32, limit >> 8);
+                if high < top || high == top && rng.bits(8) <= limit & 0xff {
+                    want |= 1 << i;
+                }
             }
-        });
-        let targets = self.assign(occ, |c| { let x = quanta(v[c]); dot(x, x) }, 0, &want, wanted, key, &mut rng);
+        }
+
+        // M5.6.
+        let targets = if want == 0 {
+            IDENTITY
+        } else {
+            let wants = [want & 3, want >> 2 & 3, want >> 4 & 3, want >> 6];
+            let mut per_cell = [0u8; CELLS];
+            per_cell[..4].copy_from_slice(&wants);
+            let key = usize::from(KEY_2D_OCCUPIED[usize::from(occ)]) + usize::from(KEY_2D_WANTS[usize::from(want)]);
+            self.assign(occ, |c| { let x = quanta(lanes, c); dot(x, x) }, 0, &per_cell, (want | want >> 2 | want >> 4 | want >> 6) & 3, key, &mut rng)
+        };
 
         self.counters.processed += 1;
         let moved = (targets ^ IDENTITY) & FIELDS[usize::from(occ)] != 0;
@@ -642,7 +777,11 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
                 let t = (targets >> (4 * c) & 7) as usize;
                 after |= 1 << t;
                 if t != c || pending >> c & 1 != 0 {
-                    velocity.set(x0 + (t & 1) + row.cell[t >> 1], v[c]);
+                    let q = quanta(lanes, c);
+                    let mut stored = [Q::default(); D];
+                    stored[0] = Q::from_int(q[0] as i32);
+                    stored[1] = Q::from_int(q[1] as i32);
+                    velocity.set(x0 + (t & 1) + row.cell[t >> 1], stored);
                 }
             }
         });
@@ -707,6 +846,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
             }
         }
         let mut rng = sh.key.stream(row.index + bx as u64);
+        let mut bytes = None;
 
         // M5.1 external force: v <- v + dt F / m (eqs. 4-5).
         for c in cells_of(occ) {
@@ -756,7 +896,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
         let mut wanted = 0u8;
         let mut key = if D == 2 { usize::from(BLOCKED_KEY_2D[usize::from(blocked & 15)]) } else { 0 };
         for c in cells_of(occ) {
-            let mut m = self.decide(b.v[c], c, &mut rng);
+            let mut m = self.decide(b.v[c], c, &mut bytes, &mut rng);
             let t = c ^ usize::from(m);
             if m != 0 && blocked >> t & 1 != 0 {
                 let to = Wanted { cell: t, site: cell(t), at: at(t), wall: wall >> t & 1 != 0 };
@@ -822,7 +962,7 @@ impl<'a, Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Bloc
         let sh = self.shared;
         if !GENERAL && sh.plain && row.outside == 0 && x0 >= 0 {
             let x0 = x0 as usize;
-            if D == 2 && !sh.desc.contacts && x0 & 63 != 63 && x0 + 1 < sh.n[0] {
+            if D == 2 && Q::LANES && !sh.desc.contacts && x0 & 63 != 63 && x0 + 1 < sh.n[0] {
                 if !sh.desc.obstacles || read_block::<CELLS>(sh.obstacle, row, [x0, x0 + 1]) == 0 {
                     return self.lean_2d(row, x0, row.index + bx as u64, occ);
                 }
@@ -837,5 +977,55 @@ impl<'a, Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Bloc
             }
         }
         self.general(row, x0, bx, occ);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::assign::digit;
+    use crate::rng::block_stream;
+
+    #[test]
+    fn inward_lanes_match_the_rule_lane_by_lane() {
+        // Expect: bit 2c + k set exactly where cell c is occupied and its
+        // component k is positive on the low side of axis k, negative on
+        // the high side; for random lanes (every byte value) and every mask.
+        let mut rng = block_stream(1, 2, 3);
+        for round in 0..20_000 {
+            let lanes = if round < 256 { 0x0101_0101_0101_0101 * round as u64 } else { rng.next_u64() };
+            for occ in 0..16u8 {
+                let mut want = 0u8;
+                for c in 0..4 {
+                    for k in 0..2 {
+                        let q = (lanes >> (8 * (2 * c + k))) as u8 as i8;
+                        let inward = if (c >> k) & 1 == 0 { q > 0 } else { q < 0 };
+                        if occ >> c & 1 != 0 && inward {
+                            want |= 1 << (2 * c + k);
+                        }
+                    }
+                }
+                assert_eq!(inward_lanes(lanes, occ), want, "{lanes:#018x} {occ:#06b}");
+            }
+        }
+    }
+
+    #[test]
+    fn split_keys_add_up_to_the_table_key() {
+        // Expect: for every occupancy and every wish of the occupied cells,
+        // the two look-ups give the key digit by digit (M5.6).
+        for occ in 0..16usize {
+            for want in 0..256usize {
+                if (0..4).any(|c| occ >> c & 1 == 0 && (want >> (2 * c)) & 3 != 0) {
+                    continue;
+                }
+                let mut key = 0;
+                for c in 0..4 {
+                    let particle = (occ >> c & 1 != 0).then_some((want >> (2 * c)) as u8 & 3);
+                    key += PLACE_2D[c] * digit(true, particle);
+                }
+                assert_eq!(KEY_2D_OCCUPIED[occ] + KEY_2D_WANTS[want], key);
+            }
+        }
     }
 }

@@ -5,7 +5,7 @@
 //!
 //! The step works in quanta: a velocity nothing changed is an integer and
 //! stays one, and M5.3's move decision is an integer comparison of 16 random
-//! bits against a threshold of the stored component ([`Quant::threshold`]).
+//! bits against a threshold of the stored component ([`Quant::move_limit`]).
 
 use crate::desc::Drift;
 use crate::rng::Stream;
@@ -37,6 +37,14 @@ pub(crate) trait Quant: Copy + Default + Send + crate::layout::Plain + 'static {
     fn from_int(q: i32) -> Self;
     fn to_int(self) -> i32;
 
+    /// Whether a 2D block row's two velocities fit one 32-bit word of byte
+    /// lanes ([`Quant::lanes_2d`]): 8-bit storage.
+    const LANES: bool;
+    /// A 2D block row's two stored velocities as byte lanes, lane `2c + k`
+    /// holding cell `c`'s component `k` (where [`Quant::LANES`]; 0
+    /// otherwise).
+    fn lanes_2d<const D: usize>(pair: [[Self; D]; 2]) -> u32;
+
     #[inline]
     fn get(self) -> f32 {
         self.to_int() as f32 * (1.0 / Self::SCALE)
@@ -50,24 +58,39 @@ pub(crate) trait Quant: Copy + Default + Send + crate::layout::Plain + 'static {
     }
 
     /// Stochastic rounding of `x`, a velocity component in quanta (clamped
-    /// to the stored range), with 16 random bits `r`: `x` is put on a grid of
-    /// 2^-16 quanta (to nearest, halves away from zero, so no direction is
-    /// favoured), and the result is its integer part rounded down, plus one
-    /// when `r` is below the fraction's 16 bits. `E[result] = x` to within
-    /// 2^-17 of a quantum; an integer `x` is returned as it is.
+    /// to the stored range), with 16 random bits `r`: the integer part of
+    /// `x` rounded down, plus one for a share of the `2^16` values of `r`
+    /// equal to the fraction of `x` on a grid of `2^-16` quanta. `E[result]
+    /// = x` to within `2^-16` of a quantum; an integer `x` is returned as it
+    /// is, and NaN gives 0.
+    ///
+    /// 8-bit storage adds `x + 128` (in `[1, 255]`, where `f32` steps are
+    /// `2^-16` or finer) and `r 2^-16` in `f32` and truncates: the sum needs
+    /// no rounding above 128, so it is one add and one conversion. 16-bit
+    /// storage would lose bits that way and puts `x` on the grid in fixed
+    /// point first.
     #[inline(always)]
     fn stochastic(x: f32, r: u32) -> i32 {
-        let x = x.clamp(-Self::SCALE, Self::SCALE) * 65536.0;
+        let x = x.clamp(-Self::SCALE, Self::SCALE);
+        if x.is_nan() {
+            return 0;
+        }
+        if Self::SCALE < 128.0 {
+            let y = (x + 128.0) + (r & 0xffff) as f32 * (1.0 / 65536.0);
+            return y as i32 - 128;
+        }
+        let x = x * 65536.0;
         // |x| <= 32767 * 2^16 < 2^31: the cast does not saturate.
         let fixed = (x + 0.5f32.copysign(x)) as i32;
         (fixed >> 16) + i32::from(r & 0xffff < (fixed & 0xffff) as u32)
     }
 
-    /// M1: every component of `x` (in quanta) rounded stochastically, from
-    /// one 64-bit output of the stream, 16 bits a component.
+    /// M1: every component of `x` (in quanta) rounded stochastically, 16
+    /// bits of the stream a component: 32 bits in 2D, a whole 64-bit output
+    /// in 3D.
     #[inline(always)]
     fn round<const D: usize>(x: [f32; 3], rng: &mut Stream) -> [i32; D] {
-        let r = rng.next_u64();
+        let r = if D == 2 { u64::from(rng.bits(32)) } else { rng.next_u64() };
         let mut out = [0; D];
         for k in 0..D {
             out[k] = Self::stochastic(x[k], (r >> (16 * k)) as u32);
@@ -75,11 +98,12 @@ pub(crate) trait Quant: Copy + Default + Send + crate::layout::Plain + 'static {
         out
     }
 
-    /// M5.3: whether 16 random bits `r` say "move" for a stored component
-    /// `q` (in quanta, not 0; its sign ignored) under `drift`: `r` below
-    /// `p 2^16` rounded, with `p` the drift rule's probability. `table` is
-    /// [`move_table_8`]'s table for `drift`, which 8-bit storage reads.
-    fn wants_move(table: &[u16; 256], drift: Drift, q: i32, r: u32) -> bool;
+    /// M5.3: the largest 16 random bits `r` that say "move" for a stored
+    /// component `q` (in quanta, not 0; its sign ignored) under `drift`:
+    /// `r <= limit` for `round(p 2^16)` of the `2^16` values of `r`, with `p`
+    /// the drift rule's probability. `table` is [`move_table_8`]'s table for
+    /// `drift`, which 8-bit storage reads.
+    fn move_limit(table: &[u16; 256], drift: Drift, q: i32) -> u32;
 }
 
 /// `round(p 2^16)` for `p = a/127` (paper) and `p = 2a/(127 + a)`
@@ -119,6 +143,11 @@ pub(crate) fn move_table_8(drift: Drift) -> &'static [u16; 256] {
 
 impl Quant for i8 {
     const SCALE: f32 = 127.0;
+    const LANES: bool = true;
+    #[inline(always)]
+    fn lanes_2d<const D: usize>(pair: [[Self; D]; 2]) -> u32 {
+        u32::from_le_bytes([pair[0][0] as u8, pair[0][1] as u8, pair[1][0] as u8, pair[1][1] as u8])
+    }
     #[inline]
     fn from_int(q: i32) -> Self {
         q.clamp(-127, 127) as i8
@@ -128,14 +157,18 @@ impl Quant for i8 {
         i32::from(self)
     }
     #[inline]
-    fn wants_move(table: &[u16; 256], _: Drift, q: i32, r: u32) -> bool {
-        r <= u32::from(table[usize::from(q as u8)])
+    fn move_limit(table: &[u16; 256], _: Drift, q: i32) -> u32 {
+        u32::from(table[usize::from(q as u8)])
     }
 }
 
 #[cfg(feature = "q16")]
 impl Quant for i16 {
     const SCALE: f32 = 32767.0;
+    const LANES: bool = false;
+    fn lanes_2d<const D: usize>(_: [[Self; D]; 2]) -> u32 {
+        0
+    }
     #[inline]
     fn from_int(q: i32) -> Self {
         q.clamp(-32767, 32767) as i16
@@ -145,7 +178,7 @@ impl Quant for i16 {
         i32::from(self)
     }
     #[inline]
-    fn wants_move(_: &[u16; 256], drift: Drift, q: i32, r: u32) -> bool {
+    fn move_limit(_: &[u16; 256], drift: Drift, q: i32) -> u32 {
         // 32,768 thresholds would not fit a table; f32 holds a/32767 to
         // 2^-24, far finer than the 2^-16 steps of the threshold.
         let a = q.unsigned_abs().min(32767) as f32 * (1.0 / Self::SCALE);
@@ -153,7 +186,8 @@ impl Quant for i16 {
             Drift::Paper => a,
             Drift::Calibrated => 2.0 * a / (1.0 + a),
         };
-        r < (p * 65536.0 + 0.5) as u32
+        // 0 for q = 0 (which never moves: M5.3 asks only inward axes).
+        ((p * 65536.0 + 0.5) as u32).saturating_sub(1)
     }
 }
 
@@ -223,14 +257,14 @@ mod tests {
             let table = move_table_8(drift);
             for q in (-127..=127).filter(|&q| q != 0) {
                 let want = p(f64::from(q).abs() / 127.0) * 65536.0;
-                let got = moves(&|r| i8::wants_move(table, drift, q, r));
+                let got = moves(&|r| r <= i8::move_limit(table, drift, q));
                 assert!((got - want).abs() <= 0.5, "{drift:?} {q}: {got} vs {want}");
             }
-            assert_eq!(moves(&|r| i8::wants_move(table, drift, -127, r)), 65536.0);
+            assert_eq!(moves(&|r| r <= i8::move_limit(table, drift, -127)), 65536.0);
             #[cfg(feature = "q16")]
             for q in [-32767, -20000, -1, 1, 777, 32767] {
                 let want = p(f64::from(q).abs() / 32767.0) * 65536.0;
-                let got = moves(&|r| i16::wants_move(table, drift, q, r));
+                let got = moves(&|r| r <= i16::move_limit(table, drift, q));
                 assert!((got - want).abs() <= 0.51, "{drift:?} {q}: {got} vs {want}");
             }
         }
