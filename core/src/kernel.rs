@@ -240,6 +240,13 @@ fn inward_lanes(lanes: u64, occ: u8) -> u8 {
     ((inward >> 7).wrapping_mul(0x0102_0408_1020_4080) >> 56) as u8
 }
 
+/// Cell `c`'s velocity from a 2D block's byte lanes, in quanta.
+#[inline(always)]
+fn lane_quanta(lanes: u64, c: usize) -> [f32; 3] {
+    let q = (lanes >> (16 * c)) as u16;
+    [f32::from(q as u8 as i8), f32::from((q >> 8) as u8 as i8), 0.0]
+}
+
 /// Runs `$body` once for each cell of a block of `$cells` cells, with `$c`
 /// bound to the cell's number as a constant: every index, side and table
 /// entry derived from the cell folds at compile time, where a loop over the
@@ -683,6 +690,39 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
         self.occupy(row, xs, occ, after);
     }
 
+    /// M5.1 (a uniform force) and M5.2 (on `pair`, when both its cells hold
+    /// a particle) on a block of byte lanes ([`Kernel::lean_2d`]), then M1:
+    /// the lanes after rounding, and the cells whose velocity changed. Out
+    /// of line: most blocks of most steps need neither.
+    #[inline(never)]
+    fn change_lanes(&mut self, mut lanes: u64, occ: u8, pair: Option<(usize, usize)>, rng: &mut Stream) -> (u64, u8) {
+        let mass = self.shared.desc.mass;
+        let mut x = [[0.0f32; 3]; CELLS];
+        let mut pending = 0u8;
+        if let Some(dv) = self.shared.push {
+            for c in cells_of(occ) {
+                let mut y = lane_quanta(lanes, c);
+                y[0] += dv[0];
+                y[1] += dv[1];
+                clamp_counted(&mut y, Q::SCALE, mass, &mut self.counters);
+                x[c] = y;
+            }
+            pending = occ;
+        }
+        if let Some((a, c)) = pair {
+            let get = |c: usize| if pending >> c & 1 != 0 { x[c] } else { lane_quanta(lanes, c) };
+            if let Some(pair) = self.collide_two(get(a), get(c), (mass, mass), true, rng) {
+                (x[a], x[c]) = pair;
+                pending |= 1 << a | 1 << c;
+            }
+        }
+        for c in cells_of(pending) {
+            let [qx, qy] = Q::round::<2>(x[c], rng).map(|q| u64::from(Q::from_int(q).to_int() as u8));
+            lanes = lanes & !(0xffff << (16 * c)) | (qx | qy << 8) << (16 * c);
+        }
+        (lanes, pending)
+    }
+
     /// [`Kernel::lean`] for a 2D block of an 8-bit world whose two cells of
     /// each row are neighbours in one occupancy word (`x0 % 64 != 63`, no
     /// wrap), in a world without contacts. The block's stored velocities
@@ -696,7 +736,6 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
     #[inline(always)]
     fn lean_2d(&mut self, row: &BlockRow, x0: usize, index: u64, occ: u8) {
         let sh = self.shared;
-        let mass = sh.desc.mass;
         let velocity = self.planes.velocity;
         let mut lanes = 0u64;
         for r in 0..2 {
@@ -704,36 +743,11 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
                 lanes |= u64::from(Q::lanes_2d(velocity.pair(x0 + row.cell[r]))) << (32 * r);
             }
         }
-        let quanta = |lanes: u64, c: usize| {
-            let q = (lanes >> (16 * c)) as u16;
-            [f32::from(q as u8 as i8), f32::from((q >> 8) as u8 as i8), 0.0]
-        };
         let mut rng = sh.key.stream(index);
-
-        // M5.1 and M5.2 leave their velocities in `x`, in quanta, marked in
-        // `pending`; M1 rounds them back into their lanes.
-        let mut x = [[0.0f32; 3]; CELLS];
+        let pair = pick_pair::<D>(occ, &mut rng);
         let mut pending = 0u8;
-        if let Some(dv) = sh.push {
-            for c in cells_of(occ) {
-                let mut y = quanta(lanes, c);
-                y[0] += dv[0];
-                y[1] += dv[1];
-                clamp_counted(&mut y, Q::SCALE, mass, &mut self.counters);
-                x[c] = y;
-            }
-            pending = occ;
-        }
-        if let Some((a, c)) = pick_pair::<D>(occ, &mut rng) {
-            let get = |c: usize| if pending >> c & 1 != 0 { x[c] } else { quanta(lanes, c) };
-            if let Some(pair) = self.collide_two(get(a), get(c), (mass, mass), true, &mut rng) {
-                (x[a], x[c]) = pair;
-                pending |= 1 << a | 1 << c;
-            }
-        }
-        for c in cells_of(pending) {
-            let [qx, qy] = Q::round::<2>(x[c], &mut rng).map(|q| u64::from(Q::from_int(q).to_int() as u8));
-            lanes = lanes & !(0xffff << (16 * c)) | (qx | qy << 8) << (16 * c);
+        if sh.push.is_some() || pair.is_some() {
+            (lanes, pending) = self.change_lanes(lanes, occ, pair, &mut rng);
         }
 
         // M5.3: the lanes that point inward, then a move table entry for
@@ -763,7 +777,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
             let mut per_cell = [0u8; CELLS];
             per_cell[..4].copy_from_slice(&wants);
             let key = usize::from(KEY_2D_OCCUPIED[usize::from(occ)]) + usize::from(KEY_2D_WANTS[usize::from(want)]);
-            self.assign(occ, |c| { let x = quanta(lanes, c); dot(x, x) }, 0, &per_cell, (want | want >> 2 | want >> 4 | want >> 6) & 3, key, &mut rng)
+            self.assign(occ, |c| { let x = lane_quanta(lanes, c); dot(x, x) }, 0, &per_cell, (want | want >> 2 | want >> 4 | want >> 6) & 3, key, &mut rng)
         };
 
         self.counters.processed += 1;
@@ -777,7 +791,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
                 let t = (targets >> (4 * c) & 7) as usize;
                 after |= 1 << t;
                 if t != c || pending >> c & 1 != 0 {
-                    let q = quanta(lanes, c);
+                    let q = lane_quanta(lanes, c);
                     let mut stored = [Q::default(); D];
                     stored[0] = Q::from_int(q[0] as i32);
                     stored[1] = Q::from_int(q[1] as i32);
@@ -962,9 +976,14 @@ impl<'a, Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Bloc
         let sh = self.shared;
         if !GENERAL && sh.plain && row.outside == 0 && x0 >= 0 {
             let x0 = x0 as usize;
-            if D == 2 && Q::LANES && !sh.desc.contacts && x0 & 63 != 63 && x0 + 1 < sh.n[0] {
-                if !sh.desc.obstacles || read_block::<CELLS>(sh.obstacle, row, [x0, x0 + 1]) == 0 {
-                    return self.lean_2d(row, x0, row.index + bx as u64, occ);
+            if D == 2 && Q::LANES {
+                // 2D, 8 bits: the lanes routine or the general one (the
+                // few blocks across a word or the wrap, worlds with
+                // contacts), never `lean`, which this routine then leaves out.
+                if !sh.desc.contacts && x0 & 63 != 63 && x0 + 1 < sh.n[0] {
+                    if !sh.desc.obstacles || read_block::<CELLS>(sh.obstacle, row, [x0, x0 + 1]) == 0 {
+                        return self.lean_2d(row, x0, row.index + bx as u64, occ);
+                    }
                 }
                 return self.general(row, x0 as isize, bx, occ);
             }
