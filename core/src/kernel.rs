@@ -234,7 +234,7 @@ fn inward_lanes(lanes: u64, occ: u8) -> u8 {
     const HIGH: u64 = 0x8080_8080_8080_8080;
     const LOW: u64 = 0x7f7f_7f7f_7f7f_7f7f;
     // The high bit of each lane: set where the lane is not 0.
-    let nonzero = ((lanes & LOW) + LOW | lanes) & HIGH;
+    let nonzero = (((lanes & LOW) + LOW) | lanes) & HIGH;
     let inward = nonzero & !(lanes ^ HIGH_SIDE_2D) & LANES_2D[usize::from(occ & 15)];
     // Gather the eight high bits into one byte.
     ((inward >> 7).wrapping_mul(0x0102_0408_1020_4080) >> 56) as u8
@@ -546,14 +546,14 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
     /// M5.6: where each particle goes, `targets >> 4c & 7` for the particle
     /// in cell `c`, counting those not placed in their desired cell. `want`
     /// holds the axes each wants to cross (a desired cell is never blocked:
-    /// M5.4 has turned such a wish into staying), `wanted` their union;
-    /// `key` is the 2D table key.
+    /// M5.4 has turned such a wish into staying); `speed2` gives a cell's
+    /// squared speed (for greedy); `key` is the 2D table key.
     #[inline(always)]
-    fn assign(&mut self, occ: u8, speed2: impl Fn(usize) -> f32, blocked: u8, want: &[u8; CELLS], wanted: u8, key: usize, rng: &mut Stream) -> u32 {
+    fn assign(&mut self, occ: u8, speed2: impl Fn(usize) -> f32, blocked: u8, want: &[u8; CELLS], key: usize, rng: &mut Stream) -> u32 {
         // Where nobody wants to move, or the block holds one particle, the
         // optimum is unique (everyone stays; the particle takes the free cell
         // it wants) and no method draws for it: take it directly.
-        if wanted == 0 {
+        if *want == [0; CELLS] {
             return IDENTITY;
         }
         if occ & (occ - 1) == 0 {
@@ -667,7 +667,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
                 }
             }
         });
-        let targets = self.assign(occ, |c| { let x = b.velocity(c); dot(x, x) }, 0, &want, wanted, key, &mut rng);
+        let targets = self.assign(occ, |c| { let x = b.velocity(c); dot(x, x) }, 0, &want, key, &mut rng);
         if sh.desc.contacts && wanted != 0 {
             self.contacts(&mut b, &want, targets, |_| mass, true);
             b.round::<Q>(&mut rng);
@@ -777,7 +777,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
             let mut per_cell = [0u8; CELLS];
             per_cell[..4].copy_from_slice(&wants);
             let key = usize::from(KEY_2D_OCCUPIED[usize::from(occ)]) + usize::from(KEY_2D_WANTS[usize::from(want)]);
-            self.assign(occ, |c| { let x = lane_quanta(lanes, c); dot(x, x) }, 0, &per_cell, (want | want >> 2 | want >> 4 | want >> 6) & 3, key, &mut rng)
+            self.assign(occ, |c| { let x = lane_quanta(lanes, c); dot(x, x) }, 0, &per_cell, key, &mut rng)
         };
 
         self.counters.processed += 1;
@@ -925,7 +925,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
         }
 
         // M5.6 move.
-        let targets = self.assign(occ, |c| { let x = b.velocity(c); dot(x, x) }, blocked, &want, wanted, key, &mut rng);
+        let targets = self.assign(occ, |c| { let x = b.velocity(c); dot(x, x) }, blocked, &want, key, &mut rng);
 
         // M5.7 contacts, then M1 for what they changed.
         if desc.contacts && wanted != 0 {
@@ -980,10 +980,9 @@ impl<'a, Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Bloc
                 // 2D, 8 bits: the lanes routine or the general one (the
                 // few blocks across a word or the wrap, worlds with
                 // contacts), never `lean`, which this routine then leaves out.
-                if !sh.desc.contacts && x0 & 63 != 63 && x0 + 1 < sh.n[0] {
-                    if !sh.desc.obstacles || read_block::<CELLS>(sh.obstacle, row, [x0, x0 + 1]) == 0 {
-                        return self.lean_2d(row, x0, row.index + bx as u64, occ);
-                    }
+                let pairwise = !sh.desc.contacts && x0 & 63 != 63 && x0 + 1 < sh.n[0];
+                if pairwise && (!sh.desc.obstacles || read_block::<CELLS>(sh.obstacle, row, [x0, x0 + 1]) == 0) {
+                    return self.lean_2d(row, x0, row.index + bx as u64, occ);
                 }
                 return self.general(row, x0 as isize, bx, occ);
             }
