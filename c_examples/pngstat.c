@@ -15,7 +15,7 @@
 
 #include <png.h>
 
-#include "render.h"
+#include "image.h"
 
 static void fail(png_structp png, png_const_charp message) {
     fprintf(stderr, "pngstat: %s: %s\n", (const char *)png_get_error_ptr(png), message);

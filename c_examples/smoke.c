@@ -12,7 +12,7 @@
  */
 #include <math.h>
 
-#include "render.h"
+#include "scene.h"
 
 /* Built a second time with -DSMOKE_FLOW as `smoke-flow` (M5.1b, beyond the
  * paper; tests/src/scenes.rs `smoke_flow()`): the same emitter and vortex
