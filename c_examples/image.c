@@ -40,7 +40,7 @@ static void png_warn(png_structp png, png_const_charp message) {
 }
 
 /* libpng's errors end the program, so no setjmp is needed. */
-void png_write(const char *path, const image *im) {
+void png_write(const char *path, const image *im, int level) {
     FILE *f = fopen(path, "wb");
     if (!f) {
         fprintf(stderr, "cannot write %s: %s\n", path, strerror(errno));
@@ -55,7 +55,7 @@ void png_write(const char *path, const image *im) {
     png_init_io(png, f);
     png_set_IHDR(png, info, im->width, im->height, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
                  PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
-    png_set_compression_level(png, 9);
+    png_set_compression_level(png, level);
     png_write_info(png, info);
     png_set_filler(png, 0, PNG_FILLER_AFTER); /* rows are RGBA: skip A */
     for (uint32_t y = 0; y < im->height; y++) {

@@ -35,7 +35,8 @@ void image_blit_gl(image *dst, const uint8_t *gl_rgba, uint32_t w, uint32_t h, u
 /* Draws `text` with its top left corner at (x0, y0). */
 void image_label(image *im, uint32_t x0, uint32_t y0, const char *text);
 
-/* Writes `im` as an 8-bit RGB PNG (alpha dropped); exits on failure. */
-void png_write(const char *path, const image *im);
+/* Writes `im` as an 8-bit RGB PNG (alpha dropped) at zlib compression
+ * `level` (0 to 9); exits on failure. */
+void png_write(const char *path, const image *im, int level);
 
 #endif /* MPCA_EXAMPLES_IMAGE_H */

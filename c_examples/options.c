@@ -26,11 +26,12 @@ static void usage(const scene *s, FILE *f) {
             "  --out DIR   output folder, created if missing (default " DEFAULT_OUT ")\n"
             "  --name S    file name prefix (default %s)\n"
             "  --threads N step in tasks on N threads, 1 to 16 (M11; default: mpca_world_step)\n"
+            "  --png-level N  PNG compression, 0 (none) to 9 (smallest, slowest; default %d)\n"
             "  --version   print the program's and libmpca's versions and exit\n"
             "  --help      print this and exit\n",
             s->name, s->title, s->about, (unsigned)d->size, (unsigned long long)d->steps,
             (unsigned long long)d->seed, (unsigned long long)d->every, (unsigned)d->tiles, (unsigned)d->px,
-            s->name);
+            s->name, DEFAULT_PNG_LEVEL);
 }
 
 static int parse_u64(const char *text, uint64_t max, uint64_t *out) {
@@ -47,6 +48,7 @@ int options_parse(const scene *s, scene_opts *o, int argc, char **argv) {
     *o = s->defaults;
     o->out = DEFAULT_OUT;
     o->name = s->name;
+    o->png_level = DEFAULT_PNG_LEVEL;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
@@ -84,6 +86,9 @@ int options_parse(const scene *s, scene_opts *o, int argc, char **argv) {
         } else if (strcmp(a, "--threads") == 0) {
             ok = parse_u64(value, 16, &v) && v >= 1;
             o->threads = (uint32_t)v;
+        } else if (strcmp(a, "--png-level") == 0) {
+            ok = parse_u64(value, 9, &v);
+            o->png_level = (uint32_t)v;
         } else if (strcmp(a, "--name") == 0) {
             ok = value && *value && !strchr(value, '/');
             o->name = value;

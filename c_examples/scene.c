@@ -192,7 +192,7 @@ int scene_main(const scene *s, int argc, char **argv) {
             double t1 = now_s();
             image_blit_gl(&frame, frame_gl, fv.width, fv.height, 0, 0);
             snprintf(path, path_len, "%s/%s-%0*llu.png", o.out, o.name, digits, (unsigned long long)t);
-            png_write(path, &frame);
+            png_write(path, &frame, (int)o.png_level);
             draw_s += t1 - t0;
             png_s += now_s() - t1;
             images++;
@@ -227,7 +227,7 @@ int scene_main(const scene *s, int argc, char **argv) {
     }
     double t0 = now_s();
     snprintf(path, path_len, "%s/%s-sheet.png", o.out, o.name);
-    png_write(path, &sheet);
+    png_write(path, &sheet, (int)o.png_level);
     png_s += now_s() - t0;
     printf("sheet: %s size=%ux%u tiles=%u\n", path, (unsigned)sheet.width, (unsigned)sheet.height, (unsigned)tiles);
 

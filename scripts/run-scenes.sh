@@ -49,13 +49,17 @@ echo "== the scenes, full size, images in $out"
 logs=$(mktemp -d)
 trap 'rm -rf "$logs"' EXIT
 runs=(aggregation cluster smoke water smoke-long smoke-flow)
+# Images to be checked in are compressed harder: size matters there, the
+# time does not.
+png=()
+[ "$docs" -eq 0 ] || png=(--png-level 9)
 for run in "${runs[@]}"; do
     case "$run" in
         smoke-long) args=(smoke --steps 480 --every 40 --name smoke-long) ;;
         *) args=("$run") ;;
     esac
     echo "-- ${args[*]}"
-    "$bin/${args[0]}" "${args[@]:1}" --out "$out" | tee "$logs/$run.log"
+    "$bin/${args[0]}" "${args[@]:1}" "${png[@]}" --out "$out" | tee "$logs/$run.log"
 done
 
 # One row per run: the program's own figures.
@@ -94,9 +98,9 @@ if [ "$docs" -eq 1 ]; then
             px=$((px / 2))
             small="$logs/px$px"
             case "$run" in
-                smoke-long) "$bin/smoke" --steps 480 --every 0 --name smoke-long --px $px --out "$small" >/dev/null ;;
-                smoke-flow) "$bin/smoke-flow" --every 0 --px $px --out "$small" >/dev/null ;;
-                *) "$bin/$run" --every 0 --px $px --out "$small" >/dev/null ;;
+                smoke-long) "$bin/smoke" --steps 480 --every 0 --name smoke-long --px $px "${png[@]}" --out "$small" >/dev/null ;;
+                smoke-flow) "$bin/smoke-flow" --every 0 --px $px "${png[@]}" --out "$small" >/dev/null ;;
+                *) "$bin/$run" --every 0 --px $px "${png[@]}" --out "$small" >/dev/null ;;
             esac
             sheet="$small/$run-sheet.png"
         done
