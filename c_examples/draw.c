@@ -1,11 +1,10 @@
 /*
  * OpenGL drawing through OSMesa: the off-screen canvas, the 2D and 3D
- * views, the fixed parts of the scenes (walls, floor, sphere) and the
- * particles. See draw.h.
+ * views and the fixed parts of the scenes (walls, floor, sphere) with GL's
+ * fixed-function pipeline; the particles and the density through the
+ * shader path of gpu.c. See draw.h.
  */
 #define _POSIX_C_SOURCE 200809L
-/* glPointParameter* (OpenGL 1.4) are declared only with this. */
-#define GL_GLEXT_PROTOTYPES
 
 #include "draw.h"
 
@@ -16,6 +15,7 @@
 #include <GL/osmesa.h>
 
 #include "common.h"
+#include "gpu.h"
 #include "image.h"
 
 #define PI_F 3.14159265358979323846f
@@ -58,70 +58,35 @@ void canvas_end(canvas *c, const char *what) {
     }
 }
 
-/* ---- colours ------------------------------------------------------------- */
-
-/* Piecewise linear through `n` stops; every stop and every blend of two
- * neighbouring stops keeps max - min of its channels far above
- * RENDER_CHROMA_MIN, so a particle is never mistaken for a grey. */
-static void ramp(const uint8_t (*stops)[3], int n, float t, uint8_t rgb[3]) {
-    if (!(t > 0.0f)) t = 0.0f; /* also NaN */
-    if (t > 1.0f) t = 1.0f;
-    float x = t * (float)(n - 1);
-    int i = (int)x;
-    if (i >= n - 1) i = n - 2;
-    float f = x - (float)i;
-    for (int k = 0; k < 3; k++) {
-        rgb[k] = (uint8_t)lrintf((1.0f - f) * (float)stops[i][k] + f * (float)stops[i + 1][k]);
-    }
-}
-
-void speed_colour(float speed, uint8_t rgb[3]) {
-    /* blue, cyan, green, yellow, red: slow to fast */
-    static const uint8_t stops[5][3] = {
-        {50, 100, 230}, {40, 200, 220}, {110, 220, 70}, {250, 200, 40}, {240, 60, 40},
-    };
-    ramp(stops, 5, speed, rgb);
-}
-
-void water_colour(float speed, uint8_t rgb[3]) {
-    static const uint8_t stops[3][3] = {{25, 80, 215}, {40, 160, 240}, {150, 235, 255}};
-    ramp(stops, 3, speed, rgb);
-}
+/* ---- colours and the particles' GPU objects ------------------------------------ */
 
 void grey(float level) {
     glColor3f(level, level, level);
 }
 
-static float speed_of(const float *v) {
-    return sqrtf(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+/* The shader path (gpu.h), created at the first particle drawn, with the
+ * canvas's context current. */
+static gpu *shaders;
+
+static gpu *gpu_of_canvas(void) {
+    if (!shaders) shaders = gpu_create();
+    return shaders;
 }
 
-/* ---- particles out of the library ----------------------------------------- */
-
-typedef struct particle_buffers {
-    size_t capacity;
-    float *pos, *vel;
-    uint8_t *rgb;
-} particle_buffers;
-
-static particle_buffers scratch;
-
-/* Exports every particle's position and velocity; returns the count. */
-static size_t export_particles(mpca_world *w) {
-    size_t n = 0;
-    mpca_check(mpca_world_particle_count(w, &n), "mpca_world_particle_count");
-    /* Never a NULL buffer, even for no particles: the library refuses NULL
-     * whatever the capacity. */
-    if (n > scratch.capacity || !scratch.pos) {
-        scratch.capacity = n + n / 2 + 16;
-        scratch.pos = xrealloc(scratch.pos, 3 * scratch.capacity * sizeof(float));
-        scratch.vel = xrealloc(scratch.vel, 3 * scratch.capacity * sizeof(float));
-        scratch.rgb = xrealloc(scratch.rgb, 3 * scratch.capacity);
+/* The product of GL's projection and model-view matrices, as the shaders
+ * take it: the scene's fixed parts are drawn with GL's matrix stack, and
+ * the particles must land on the same pixels. */
+static void current_mvp(float mvp[16]) {
+    float p[16], m[16];
+    glGetFloatv(GL_PROJECTION_MATRIX, p);
+    glGetFloatv(GL_MODELVIEW_MATRIX, m);
+    for (int col = 0; col < 4; col++) {
+        for (int row = 0; row < 4; row++) {
+            float sum = 0.0f;
+            for (int k = 0; k < 4; k++) sum += p[k * 4 + row] * m[col * 4 + k];
+            mvp[col * 4 + row] = sum;
+        }
     }
-    size_t got = 0;
-    mpca_check(mpca_world_export_positions(w, scratch.pos, scratch.capacity, &got), "mpca_world_export_positions");
-    mpca_check(mpca_world_export_velocities(w, scratch.vel, scratch.capacity, &got), "mpca_world_export_velocities");
-    return got;
 }
 
 /* ---- 2D ---------------------------------------------------------------------- */
@@ -135,29 +100,25 @@ void view2d_begin(uint32_t nx, uint32_t ny) {
     glDisable(GL_DEPTH_TEST);
 }
 
-/* Draws the first n points of the scratch arrays (positions and colours). */
-static void draw_scratch_points(size_t n) {
-    glEnableClientState(GL_VERTEX_ARRAY);
-    glEnableClientState(GL_COLOR_ARRAY);
-    glVertexPointer(3, GL_FLOAT, 0, scratch.pos);
-    glColorPointer(3, GL_UNSIGNED_BYTE, 0, scratch.rgb);
-    glDrawArrays(GL_POINTS, 0, (GLsizei)n);
-    glDisableClientState(GL_COLOR_ARRAY);
-    glDisableClientState(GL_VERTEX_ARRAY);
+size_t draw_particles_2d(mpca_world *w, const view *v) {
+    gpu *g = gpu_of_canvas();
+    size_t n = gpu_upload_particles(g, w);
+    float mvp[16];
+    current_mvp(mvp);
+    gpu_draw_points_2d(g, mvp, (float)v->point_px);
+    return n;
 }
 
-size_t draw_particles_2d(mpca_world *w, const view *v) {
-    size_t n = export_particles(w);
-    for (size_t i = 0; i < n; i++) {
-        /* sqrt spreads the slow speeds, where a cooling gas spends its time. */
-        speed_colour(sqrtf(speed_of(&scratch.vel[3 * i])), &scratch.rgb[3 * i]);
-    }
-    /* Square, unsmoothed points: each covers point_px x point_px pixels
-     * inside its own cell, and no two particles share a cell (M1). */
-    glDisable(GL_POINT_SMOOTH);
-    glPointSize((float)v->point_px);
-    draw_scratch_points(n);
-    return n;
+void draw_density_2d(mpca_world *w, uint32_t bin, float full) {
+    gpu *g = gpu_of_canvas();
+    gpu_upload_density_2d(g, w, bin);
+    mpca_desc d;
+    d.struct_size = sizeof d;
+    mpca_check(mpca_world_desc(w, &d), "mpca_world_desc");
+    float mvp[16];
+    current_mvp(mvp);
+    const float bg[3] = {RENDER_BG_R / 255.0f, RENDER_BG_G / 255.0f, RENDER_BG_B / 255.0f};
+    gpu_draw_density_2d(g, mvp, d.size[0], d.size[1], bg, full);
 }
 
 void draw_walls_2d(const mpca_desc *desc, const view *v) {
@@ -303,38 +264,6 @@ void draw_floor_and_box(uint32_t nx, uint32_t ny, uint32_t nz, uint32_t grid) {
     glEnd();
 }
 
-/* A shaded disc for the sprites: luminance from a light at the upper left,
- * alpha 1 inside the disc and 0 outside (cut by the alpha test, so a pixel
- * is either the particle's or untouched: no blending). */
-static void sprite_texture(void) {
-    static GLuint texture;
-    if (texture) {
-        glBindTexture(GL_TEXTURE_2D, texture);
-        return;
-    }
-    enum { N = 32 };
-    static GLubyte texels[N][N][2];
-    for (int j = 0; j < N; j++) {
-        for (int i = 0; i < N; i++) {
-            float x = ((float)i + 0.5f) / (N / 2) - 1.0f, y = ((float)j + 0.5f) / (N / 2) - 1.0f;
-            float r2 = x * x + y * y;
-            float z = sqrtf(r2 < 1.0f ? 1.0f - r2 : 0.0f);
-            float lit = (-0.4f * x - 0.4f * y + 0.82f * z);
-            if (lit < 0.0f) lit = 0.0f;
-            /* Luminance at least 0.6, so the colour keeps its chroma. */
-            texels[j][i][0] = (GLubyte)lrintf(255.0f * (0.6f + 0.4f * lit));
-            texels[j][i][1] = r2 <= 1.0f ? 255 : 0;
-        }
-    }
-    glGenTextures(1, &texture);
-    glBindTexture(GL_TEXTURE_2D, texture);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-    glTexImage2D(GL_TEXTURE_2D, 0, GL_LUMINANCE_ALPHA, N, N, 0, GL_LUMINANCE_ALPHA, GL_UNSIGNED_BYTE, texels);
-}
-
 /* Distance from `p` to the nearest and the farthest point of the box. */
 static void box_distances(const float p[3], const uint32_t size[3], float *near_d, float *far_d) {
     float n2 = 0.0f, f2 = 0.0f;
@@ -350,55 +279,30 @@ static void box_distances(const float p[3], const uint32_t size[3], float *near_
 }
 
 drawn draw_particles_3d(mpca_world *w, const view *v, const camera *c, const uint32_t size[3]) {
-    drawn d = {0, 0.0f, 0.0f};
-    size_t n = export_particles(w);
-    float dmin, dmax;
-    box_distances(c->eye, size, &dmin, &dmax);
-    if (dmin < c->near_clip) dmin = c->near_clip;
-    /* Depth shading: full colour at the nearest point of the box, half at
-     * the farthest. */
-    for (size_t i = 0; i < n; i++) {
-        const float *p = &scratch.pos[3 * i];
-        float dx = p[0] - c->eye[0], dy = p[1] - c->eye[1], dz = p[2] - c->eye[2];
-        float t = (sqrtf(dx * dx + dy * dy + dz * dz) - dmin) / (dmax - dmin);
-        float shade = 1.0f - 0.5f * (t < 0.0f ? 0.0f : (t > 1.0f ? 1.0f : t));
-        uint8_t rgb[3];
-        water_colour(speed_of(&scratch.vel[3 * i]), rgb);
-        for (int k = 0; k < 3; k++) scratch.rgb[3 * i + k] = (uint8_t)lrintf(shade * (float)rgb[k]);
-    }
-    /* Perspective size: one cell at distance d is f/d pixels (the
-     * attenuation's 1/sqrt(c d^2)); clamped to what the box allows. */
-    float f = focal_px(v, c);
-    d.sprite_min_px = f / dmax;
-    d.sprite_max_px = f / dmin;
-    const GLfloat attenuation[3] = {0.0f, 0.0f, 1.0f};
-    glPointParameterfv(GL_POINT_DISTANCE_ATTENUATION, attenuation);
-    glPointParameterf(GL_POINT_SIZE_MIN, d.sprite_min_px);
-    glPointParameterf(GL_POINT_SIZE_MAX, d.sprite_max_px);
-    glPointSize(f);
-    glEnable(GL_POINT_SPRITE);
-    glTexEnvi(GL_POINT_SPRITE, GL_COORD_REPLACE, GL_TRUE);
-    glEnable(GL_TEXTURE_2D);
-    sprite_texture();
-    glTexEnvi(GL_TEXTURE_ENV, GL_TEXTURE_ENV_MODE, GL_MODULATE);
-    glEnable(GL_ALPHA_TEST);
-    glAlphaFunc(GL_GREATER, 0.5f);
-    draw_scratch_points(n);
-    glDisable(GL_ALPHA_TEST);
-    glDisable(GL_TEXTURE_2D);
-    glDisable(GL_POINT_SPRITE);
-    const GLfloat constant[3] = {1.0f, 0.0f, 0.0f};
-    glPointParameterfv(GL_POINT_DISTANCE_ATTENUATION, constant);
-    d.particles = n;
+    gpu *g = gpu_of_canvas();
+    drawn d = {gpu_upload_particles(g, w), 0.0f, 0.0f};
+    gpu_sprites sprites;
+    for (int k = 0; k < 3; k++) sprites.eye[k] = c->eye[k];
+    box_distances(c->eye, size, &sprites.near_d, &sprites.far_d);
+    if (sprites.near_d < c->near_clip) sprites.near_d = c->near_clip;
+    sprites.focal_px = focal_px(v, c);
+    /* No particle is nearer than the box's nearest point or farther than its
+     * farthest. */
+    sprites.min_px = sprites.focal_px / sprites.far_d;
+    sprites.max_px = sprites.focal_px / sprites.near_d;
+    float mvp[16];
+    current_mvp(mvp);
+    gpu_draw_sprites_3d(g, mvp, &sprites);
+    d.sprite_min_px = sprites.min_px;
+    d.sprite_max_px = sprites.max_px;
     return d;
 }
 
 void canvas_destroy(canvas *c) {
     if (!c) return;
+    /* The GPU objects go with the context, which is still current. */
+    gpu_destroy(shaders);
+    shaders = NULL;
     OSMesaDestroyContext(c->ctx);
     free(c);
-    free(scratch.pos);
-    free(scratch.vel);
-    free(scratch.rgb);
-    scratch = (particle_buffers){0, NULL, NULL, NULL};
 }

@@ -1,7 +1,8 @@
 /*
  * OpenGL drawing, off-screen through OSMesa: the canvas a frame is drawn
- * into, the 2D and 3D views, the fixed parts of the scenes and the
- * particles.
+ * into, the 2D and 3D views, the fixed parts of the scenes, and the
+ * particles and the density (drawn by gpu.c, the path a real-time engine
+ * would take).
  *
  * Pixels: frames are square. In 2D a cell is `cell_px` pixels wide and a
  * particle is a square point of `point_px` pixels (one pixel less than the
@@ -47,17 +48,18 @@ void canvas_end(canvas *c, const char *what);
 /* Frees the context and the drawing code's buffers. */
 void canvas_destroy(canvas *c);
 
-/* Speed (0..1) to a saturated colour, 2D and 3D palettes. */
-void speed_colour(float speed, uint8_t rgb[3]);
-void water_colour(float speed, uint8_t rgb[3]);
 /* A grey (0..1). */
 void grey(float level);
 
 /* 2D: an orthographic view of nx x ny cells, y up. */
 void view2d_begin(uint32_t nx, uint32_t ny);
-/* 2D: every particle as a square point coloured by its speed; returns the
- * count. */
+/* 2D: every particle as a square point coloured by its speed, through a
+ * vertex buffer and a shader (gpu.h); returns the count. */
 size_t draw_particles_2d(mpca_world *w, const view *v);
+/* 2D: the density in bins of `bin` x `bin` cells, uploaded into a texture
+ * and drawn over the whole view as grey haze (gpu.h), brightest where a
+ * bin's share of occupied cells is `full` or more. */
+void draw_density_2d(mpca_world *w, uint32_t bin, float full);
 /* 2D: the faces of the domain that are walls, as grey lines two pixels
  * wide along the image border. */
 void draw_walls_2d(const mpca_desc *desc, const view *v);
@@ -75,7 +77,8 @@ void draw_sphere(const float centre[3], float radius);
  * and the edges of the box up to height ny. */
 void draw_floor_and_box(uint32_t nx, uint32_t ny, uint32_t nz, uint32_t grid);
 /* 3D: every particle as a perspective point sprite one cell wide,
- * coloured by speed and darkened with distance. Sprite sizes are clamped to
+ * coloured by speed and darkened with distance, through a vertex buffer
+ * and a shader (gpu.h). Sprite sizes are clamped to
  * the range a particle inside the nx x ny x nz box can have, which is
  * reported with the count. */
 drawn draw_particles_3d(mpca_world *w, const view *v, const camera *c, const uint32_t size[3]);

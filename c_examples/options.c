@@ -26,12 +26,14 @@ static void usage(const scene *s, FILE *f) {
             "  --out DIR   output folder, created if missing (default " DEFAULT_OUT ")\n"
             "  --name S    file name prefix (default %s)\n"
             "  --threads N step in tasks on N threads, 1 to 16 (M11; default: mpca_world_step)\n"
+            "  --density N 2D: the density in bins of N x N cells, uploaded as a texture and\n"
+            "              drawn as grey haze under the particles; 0 for none (default %u)\n"
             "  --png-level N  PNG compression, 0 (none) to 9 (smallest, slowest; default %d)\n"
             "  --version   print the program's and libmpca's versions and exit\n"
             "  --help      print this and exit\n",
             s->name, s->title, s->about, (unsigned)d->size, (unsigned long long)d->steps,
             (unsigned long long)d->seed, (unsigned long long)d->every, (unsigned)d->tiles, (unsigned)d->px,
-            s->name, DEFAULT_PNG_LEVEL);
+            s->name, (unsigned)d->density, DEFAULT_PNG_LEVEL);
 }
 
 static int parse_u64(const char *text, uint64_t max, uint64_t *out) {
@@ -86,6 +88,9 @@ int options_parse(const scene *s, scene_opts *o, int argc, char **argv) {
         } else if (strcmp(a, "--threads") == 0) {
             ok = parse_u64(value, 16, &v) && v >= 1;
             o->threads = (uint32_t)v;
+        } else if (strcmp(a, "--density") == 0) {
+            ok = parse_u64(value, 4096, &v) && (s->dim == 2 || v == 0);
+            o->density = (uint32_t)v;
         } else if (strcmp(a, "--png-level") == 0) {
             ok = parse_u64(value, 9, &v);
             o->png_level = (uint32_t)v;

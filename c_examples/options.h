@@ -22,6 +22,7 @@ typedef struct scene_opts {
     const char *name; /* file name prefix */
     uint32_t threads; /* 0: mpca_world_step; else the parallel step on this many threads */
     uint32_t png_level; /* zlib compression level of the PNGs, 0 to 9 */
+    uint32_t density; /* 2D: the density as haze in bins of this many cells; 0: none */
 } scene_opts;
 
 struct scene;

@@ -114,9 +114,18 @@ static void make_dirs(const char *path) {
 /* Gap between the contact sheet's tiles, in pixels. */
 #define SHEET_GAP 6
 
+/* The haze is at its brightest where a quarter of a bin's cells hold a
+ * particle: smoke is sparse, and a bin that full already reads as thick. */
+#define DENSITY_FULL 0.25f
+
 /* Draws the scene into `rgba` (v->width x v->height, rows bottom to top). */
 static drawn render(const scene *s, const scene_opts *o, mpca_world *w, canvas *c, uint8_t *rgba, const view *v) {
     canvas_begin(c, rgba, v);
+    if (o->density && s->dim == 2) {
+        /* Under everything else: it covers the whole view. */
+        view2d_begin(o->size, o->size);
+        draw_density_2d(w, o->density, DENSITY_FULL);
+    }
     drawn d = s->draw(o, w, v);
     canvas_end(c, s->name);
     return d;

@@ -134,7 +134,8 @@ int main(int argc, char **argv) {
         .name = "smoke-flow",
         .title = "4.3 smoke with flow drag (M5.1b)",
         .dim = 2,
-        .defaults = {.size = PAPER_SIZE, .steps = 1200, .seed = 43, .every = 100, .tiles = 6, .px = 512},
+        /* The density drawn as haze: smoke as a renderer would show it. */
+        .defaults = {.size = PAPER_SIZE, .steps = 1200, .seed = 43, .every = 100, .tiles = 6, .px = 512, .density = 8},
         .about = "buoyant smoke dragged towards a Rankine vortex flow: it rises at its terminal speed and rolls up",
         .build = build,
         .draw = draw,

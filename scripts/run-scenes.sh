@@ -117,7 +117,7 @@ if [ "$docs" -eq 1 ]; then
         smoke) echo "one particle a step rises from the ground and the vortex (grey guides) bends the plume;";;
         water) echo "water poured on the sphere splashes off it and spreads over the floor;";;
         smoke-long) echo "the same smoke for 480 steps: the vortex bends the plume round its right side and flings it out at the top right;";;
-        smoke-flow) echo "the smoke as buoyancy plus drag towards the vortex's flow, 1,200 steps: it rises at its terminal speed (slow colours, no clamp) and is carried up round the vortex's right side instead of being flung out; it does not wind into the core, since its rise (0.08 cells a step) is over half the flow's speed at the core (0.14).";;
+        smoke-flow) echo "the smoke as buoyancy plus drag towards the vortex's flow, 1,200 steps: it rises at its terminal speed (slow colours, no clamp) and is carried up round the vortex's right side instead of being flung out; it does not wind into the core, since its rise (0.08 cells a step) is over half the flow's speed at the core (0.14). Its density, in bins of 8 × 8 cells, is drawn as grey haze under the particles.";;
     esac; }
     # 12345 -> 12,345
     commas() { echo "$1" | sed ':a;s/\B[0-9]\{3\}\>/,&/;ta'; }
@@ -127,6 +127,10 @@ if [ "$docs" -eq 1 ]; then
         echo "The four scenes of the paper's section 4, as C programs in \`c_examples/\`"
         echo "that use only \`include/mpca.h\` and \`libmpca\`, drawn off-screen with OpenGL"
         echo "through OSMesa (no window, no display) and written as PNG with libpng."
+        echo "The particles take the path a real-time engine would: the library exports"
+        echo "their positions and velocities straight into a vertex buffer object, and"
+        echo "GLSL 1.20 shaders draw them; the density goes into a texture"
+        echo "(\`c_examples/gpu.c\`, OpenGL 2.1, so also OpenGL ES 2 and WebGL)."
         echo "Particles are coloured by speed (2D: blue slow, through green and yellow,"
         echo "to red at 1 cell per step; 3D: dark blue to light cyan, darker farther"
         echo "away); walls, the sphere and the vortex's guide circles are grey."
@@ -143,7 +147,7 @@ if [ "$docs" -eq 1 ]; then
         echo "the smoke scene a second time, for 480 steps, and with flow drag) and prints where the images"
         echo "are: \`out/scenes/\`. Each program also runs alone, e.g."
         echo "\`target/c_examples/water --size 32 --steps 200 --every 20 --out /tmp/w\`;"
-        echo "\`--help\` lists its options (\`--size --steps --seed --every --tiles --px --out --name --threads --version\`)."
+        echo "\`--help\` lists its options (\`--size --steps --seed --every --tiles --px --out --name --threads --density --png-level --version\`)."
         echo
         for run in "${runs[@]}"; do
             echo "**$(section "$run")**: $(caption "$run")"

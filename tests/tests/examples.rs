@@ -332,6 +332,49 @@ fn water_small_run_draws_the_sphere_the_box_and_the_water() {
     check_small_run("water", 32, 40, 10, Fixed::AtStepZero(0.5));
 }
 
+/// `--density N`: the density uploaded into a texture and drawn as haze
+/// under the particles (c_examples/gpu.c). The haze is grey, so the
+/// particles' pixels stay exactly theirs; where nothing is near it is the
+/// background, so the frame at step 0 (no particle yet) shows the fixed
+/// parts only, as without haze; once smoke has risen it covers more than
+/// the particles and the fixed parts.
+#[test]
+fn density_haze_is_grey_background_where_empty_and_under_the_particles() {
+    let out_dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("examples").join("density");
+    let _ = std::fs::remove_dir_all(&out_dir);
+    let out_s = out_dir.to_string_lossy().into_owned();
+    let common = ["--size", "32", "--steps", "60", "--every", "30", "--tiles", "2", "--px", "256", "--out", &out_s];
+    let runs: Vec<Vec<Drawn>> = [("plain", "0"), ("haze", "4")]
+        .iter()
+        .map(|(name, bin)| {
+            let mut args = common.to_vec();
+            args.extend(["--name", name, "--density", bin]);
+            let stdout = run("smoke-flow", &args);
+            stdout.lines().filter(|l| l.starts_with("frame: ")).map(drawn).collect()
+        })
+        .collect();
+    let (plain, haze) = (&runs[0], &runs[1]);
+    assert_eq!(haze.len(), 3, "frames at 0, 30 and 60");
+    let fixed = pngstat(plain[0].path.as_ref().unwrap());
+    let zero = pngstat(haze[0].path.as_ref().unwrap());
+    assert_eq!((haze[0].particles, zero.nonbg), (0, fixed.nonbg), "step 0: no particle, so no haze");
+    for d in haze {
+        let p = pngstat(d.path.as_ref().unwrap());
+        let (lo, hi) = particle_pixels(d);
+        assert!((lo..=hi).contains(&p.coloured), "{:?}: {} particle pixels, expected {lo}", d.path, p.coloured);
+    }
+    let last = haze.last().unwrap();
+    let p = pngstat(last.path.as_ref().unwrap());
+    assert!(last.particles > 0, "smoke rose");
+    assert!(
+        p.nonbg > p.coloured + fixed.nonbg,
+        "no haze: {} non-background pixels, {} particle pixels, {} fixed",
+        p.nonbg,
+        p.coloured,
+        fixed.nonbg
+    );
+}
+
 /// Each program at the paper's size for a few steps: the same world, bit for
 /// bit (`mpca_world_hash` against `World::state_hash`), as the scene of
 /// tests/src/scenes.rs after the same steps; stepped serially, and in the
@@ -369,15 +412,18 @@ fn every_program_documents_and_checks_its_options() {
     for scene in ["aggregation", "cluster", "smoke", "water"] {
         let help = run(scene, &["--help"]);
         for option in
-            ["--size N", "--steps N", "--seed N", "--every N", "--tiles N", "--px N", "--out DIR", "--name S", "--threads N", "--version"]
+            ["--size N", "--steps N", "--seed N", "--every N", "--tiles N", "--px N", "--out DIR", "--name S", "--threads N", "--density N", "--png-level N", "--version"]
         {
             assert!(help.contains(option), "{scene} --help does not mention {option}:\n{help}");
         }
-        for bad in [&["--size", "7"][..], &["--steps", "-1"], &["--bogus"], &["--every"], &["--threads", "0"], &["--threads", "17"]] {
+        for bad in [&["--size", "7"][..], &["--steps", "-1"], &["--bogus"], &["--every"], &["--threads", "0"], &["--threads", "17"], &["--png-level", "10"]] {
             let out = Command::new(programs().join(scene)).args(bad).output().expect("runs");
             assert_eq!(out.status.code(), Some(2), "{scene} {bad:?} should be refused");
         }
     }
+    // The density haze is 2D only.
+    let out = Command::new(programs().join("water")).args(["--density", "4"]).output().expect("runs");
+    assert_eq!(out.status.code(), Some(2), "water --density 4 should be refused");
 }
 
 /// `c_examples/threads.c`: the 1024^2 gas stepped on 1, 2 and 3 POSIX
