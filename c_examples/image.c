@@ -16,13 +16,17 @@
 image image_new(uint32_t width, uint32_t height) {
     image im = {width, height, NULL};
     im.rgba = xrealloc(NULL, (size_t)width * height * 4);
-    for (size_t i = 0; i < (size_t)width * height; i++) {
-        im.rgba[4 * i + 0] = RENDER_BG_R;
-        im.rgba[4 * i + 1] = RENDER_BG_G;
-        im.rgba[4 * i + 2] = RENDER_BG_B;
-        im.rgba[4 * i + 3] = 255;
-    }
+    image_clear(&im);
     return im;
+}
+
+void image_clear(image *im) {
+    for (size_t i = 0; i < (size_t)im->width * im->height; i++) {
+        im->rgba[4 * i + 0] = RENDER_BG_R;
+        im->rgba[4 * i + 1] = RENDER_BG_G;
+        im->rgba[4 * i + 2] = RENDER_BG_B;
+        im->rgba[4 * i + 3] = 255;
+    }
 }
 
 void image_free(image *im) {

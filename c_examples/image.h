@@ -24,6 +24,8 @@ typedef struct image {
 /* A width x height image filled with the background. */
 image image_new(uint32_t width, uint32_t height);
 void image_free(image *im);
+/* Fills `im` with the background. */
+void image_clear(image *im);
 
 /* Copies an OpenGL buffer of w x h (RGBA, rows bottom to top) into `dst`
  * with its top left corner at (x0, y0). */

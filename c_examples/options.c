@@ -16,12 +16,16 @@ static void usage(const scene *s, FILE *f) {
     fprintf(f,
             "usage: %s [options]\n"
             "%s: %s\n"
-            "Renders off-screen (OSMesa) and writes PNG frames and a contact sheet.\n"
+            "Renders off-screen (OSMesa) and writes PNG frames (NAME-frame-0000.png,\n"
+            "NAME-frame-0001.png, ...), a contact sheet (NAME-sheet.png) and an animated\n"
+            "GIF (NAME.gif).\n"
             "  --size N    cells per axis, even, at least 8 (default %u)\n"
             "  --steps N   steps to run (default %llu)\n"
             "  --seed N    seed of the world and of the initial placement (default %llu)\n"
             "  --every N   write a frame every N steps, 0 for none (default %llu)\n"
             "  --tiles N   frames in the contact sheet, 1 to 12 (default %u)\n"
+            "  --gif N     frames in the animated GIF, at the sheet's size, 0 for none,\n"
+            "              at most %d (default %d)\n"
             "  --px N      frame width in pixels (default %u; the sheet's tiles are half)\n"
             "  --out DIR   output folder, created if missing (default " DEFAULT_OUT ")\n"
             "  --name S    file name prefix (default %s)\n"
@@ -32,8 +36,8 @@ static void usage(const scene *s, FILE *f) {
             "  --version   print the program's and libmpca's versions and exit\n"
             "  --help      print this and exit\n",
             s->name, s->title, s->about, (unsigned)d->size, (unsigned long long)d->steps,
-            (unsigned long long)d->seed, (unsigned long long)d->every, (unsigned)d->tiles, (unsigned)d->px,
-            s->name, (unsigned)d->density, DEFAULT_PNG_LEVEL);
+            (unsigned long long)d->seed, (unsigned long long)d->every, (unsigned)d->tiles, MAX_GIF_FRAMES,
+            DEFAULT_GIF_FRAMES, (unsigned)d->px, s->name, (unsigned)d->density, DEFAULT_PNG_LEVEL);
 }
 
 static int parse_u64(const char *text, uint64_t max, uint64_t *out) {
@@ -51,6 +55,7 @@ int options_parse(const scene *s, scene_opts *o, int argc, char **argv) {
     o->out = DEFAULT_OUT;
     o->name = s->name;
     o->png_level = DEFAULT_PNG_LEVEL;
+    o->gif = DEFAULT_GIF_FRAMES;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
@@ -88,6 +93,9 @@ int options_parse(const scene *s, scene_opts *o, int argc, char **argv) {
         } else if (strcmp(a, "--threads") == 0) {
             ok = parse_u64(value, 16, &v) && v >= 1;
             o->threads = (uint32_t)v;
+        } else if (strcmp(a, "--gif") == 0) {
+            ok = parse_u64(value, MAX_GIF_FRAMES, &v);
+            o->gif = (uint32_t)v;
         } else if (strcmp(a, "--density") == 0) {
             ok = parse_u64(value, 4096, &v) && (s->dim == 2 || v == 0);
             o->density = (uint32_t)v;

@@ -23,7 +23,11 @@ typedef struct scene_opts {
     uint32_t threads; /* 0: mpca_world_step; else the parallel step on this many threads */
     uint32_t png_level; /* zlib compression level of the PNGs, 0 to 9 */
     uint32_t density; /* 2D: the density as haze in bins of this many cells; 0: none */
+    uint32_t gif;     /* frames in the animated GIF; 0: no GIF */
 } scene_opts;
+
+#define DEFAULT_GIF_FRAMES 40
+#define MAX_GIF_FRAMES 1000
 
 struct scene;
 

@@ -13,6 +13,7 @@
 #include <sys/stat.h>
 
 #include "common.h"
+#include "gif.h"
 #include "image.h"
 
 uint32_t scale_cells(uint32_t v, uint32_t size, uint32_t reference) {
@@ -113,6 +114,11 @@ static void make_dirs(const char *path) {
 
 /* Gap between the contact sheet's tiles, in pixels. */
 #define SHEET_GAP 6
+/* Margin of a GIF frame's label, in pixels. */
+#define GIF_GAP 4
+/* 12.5 frames a second, and a second on the last before it loops. */
+#define GIF_DELAY_CS 8
+#define GIF_LAST_DELAY_CS 100
 
 /* The haze is at its brightest where a quarter of a bin's cells hold a
  * particle: smoke is sparse, and a bin that full already reads as thick. */
@@ -150,6 +156,14 @@ static void print_drawn(const drawn *d, const view *v) {
     }
 }
 
+/* Step i of n spread evenly over 0..steps, both ends included:
+ * round(i * steps / (n - 1)); the end alone when n is 1. */
+static uint64_t spread(uint64_t i, uint64_t n, uint64_t steps) {
+    return n <= 1 ? steps : (steps * i + (n - 1) / 2) / (n - 1);
+}
+
+/* ---- the run -------------------------------------------------------------------- */
+
 int scene_main(const scene *s, int argc, char **argv) {
     scene_opts o;
     int status = options_parse(s, &o, argc, argv);
@@ -170,65 +184,90 @@ int scene_main(const scene *s, int argc, char **argv) {
            stats.bytes_per_cell);
 
     view fv = make_view(s, o.size, o.px);
-    /* Sheet tiles at half the frame's resolution (whole cells in 2D). */
+    /* Sheet tiles and GIF frames at half the frame's resolution (whole
+     * cells in 2D). */
     view tv = make_view(s, o.size, s->dim == 2 ? (fv.cell_px + 1) / 2 * o.size : o.px / 2);
     canvas *c = canvas_create();
     /* What OpenGL draws into, rows bottom to top. */
     uint8_t *frame_gl = xrealloc(NULL, (size_t)fv.width * fv.height * 4);
     uint8_t *tile_gl = xrealloc(NULL, (size_t)tv.width * tv.height * 4);
 
-    /* Sheet tiles at round(i * steps / (n - 1)), 0 and the end included. */
+    /* Sheet tiles and GIF frames spread evenly over the run, 0 and the end
+     * included, never two at one step. */
     uint32_t tiles = o.tiles;
     if ((uint64_t)tiles > o.steps + 1) tiles = (uint32_t)(o.steps + 1);
-    uint64_t tile_step[12];
-    for (uint32_t i = 0; i < tiles; i++) {
-        tile_step[i] = tiles == 1 ? o.steps : (o.steps * i + (tiles - 1) / 2) / (tiles - 1);
-    }
+    uint32_t gif_frames = o.gif;
+    if ((uint64_t)gif_frames > o.steps + 1) gif_frames = (uint32_t)(o.steps + 1);
     image sheet = image_new(tiles * tv.width + (tiles + 1) * SHEET_GAP,
                             tv.height + 3 * SHEET_GAP + LABEL_HEIGHT);
     image frame = image_new(fv.width, fv.height);
-    int digits = snprintf(NULL, 0, "%llu", (unsigned long long)o.steps);
+    /* A GIF frame: the tile with its label in a strip below. */
+    image gif_frame = image_new(tv.width, tv.height + 2 * GIF_GAP + LABEL_HEIGHT);
+    gif_anim *gif = gif_frames ? gif_new(gif_frame.width, gif_frame.height) : NULL;
+    /* Frames are numbered 0, 1, 2, ... (not by step), so that tools that
+     * read numbered sequences (ffmpeg -i NAME-frame-%04d.png) find them
+     * all; the step of each is printed. */
+    uint64_t frame_count = o.every ? o.steps / o.every + 1 + (o.steps % o.every != 0) : 0;
+    int digits = snprintf(NULL, 0, "%llu", (unsigned long long)(frame_count ? frame_count - 1 : 0));
     if (digits < 4) digits = 4;
     size_t path_len = strlen(o.out) + strlen(o.name) + 48;
     char *path = xrealloc(NULL, path_len);
 
     double sim_s = 0.0, draw_s = 0.0, png_s = 0.0;
-    uint64_t images = 0, pngs = 1, next_tile = 0; /* pngs: the frames and the sheet */
-    for (uint64_t t = 0;; ) {
+    /* pngs: the frames and the sheet */
+    uint64_t images = 0, pngs = 1, frames = 0, next_tile = 0, next_gif = 0;
+    for (uint64_t t = 0;;) {
+        char label[32];
+        snprintf(label, sizeof label, "t=%llu", (unsigned long long)t);
         if (o.every && (t % o.every == 0 || t == o.steps)) {
             double t0 = now_s();
             drawn d = render(s, &o, w, c, frame_gl, &fv);
             double t1 = now_s();
             image_blit_gl(&frame, frame_gl, fv.width, fv.height, 0, 0);
-            snprintf(path, path_len, "%s/%s-%0*llu.png", o.out, o.name, digits, (unsigned long long)t);
+            snprintf(path, path_len, "%s/%s-frame-%0*llu.png", o.out, o.name, digits, (unsigned long long)frames);
             png_write(path, &frame, (int)o.png_level);
             draw_s += t1 - t0;
             png_s += now_s() - t1;
             images++;
             pngs++;
+            frames++;
             printf("frame: %s step=%llu", path, (unsigned long long)t);
             print_drawn(&d, &fv);
         }
-        while (next_tile < tiles && tile_step[next_tile] == t) {
+        int tile_now = next_tile < tiles && spread(next_tile, tiles, o.steps) == t;
+        int gif_now = next_gif < gif_frames && spread(next_gif, gif_frames, o.steps) == t;
+        if (tile_now || gif_now) {
+            /* One drawing serves both. */
             double t0 = now_s();
             drawn d = render(s, &o, w, c, tile_gl, &tv);
             draw_s += now_s() - t0;
             images++;
-            uint32_t x0 = SHEET_GAP + next_tile * (tv.width + SHEET_GAP);
-            image_blit_gl(&sheet, tile_gl, tv.width, tv.height, x0, SHEET_GAP);
-            char label[32];
-            snprintf(label, sizeof label, "t=%llu", (unsigned long long)t);
-            image_label(&sheet, x0, tv.height + 2 * SHEET_GAP, label);
-            printf("tile: step=%llu", (unsigned long long)t);
-            print_drawn(&d, &tv);
-            next_tile++;
+            if (tile_now) {
+                uint32_t x0 = SHEET_GAP + (uint32_t)next_tile * (tv.width + SHEET_GAP);
+                image_blit_gl(&sheet, tile_gl, tv.width, tv.height, x0, SHEET_GAP);
+                image_label(&sheet, x0, tv.height + 2 * SHEET_GAP, label);
+                printf("tile: step=%llu", (unsigned long long)t);
+                print_drawn(&d, &tv);
+                next_tile++;
+            }
+            if (gif_now) {
+                image_clear(&gif_frame);
+                image_blit_gl(&gif_frame, tile_gl, tv.width, tv.height, 0, 0);
+                image_label(&gif_frame, GIF_GAP, tv.height + GIF_GAP, label);
+                gif_add(gif, &gif_frame);
+                next_gif++;
+            }
         }
         fflush(stdout);
         if (t >= o.steps) break;
-        /* Step on to the next frame, tile or the end, timing only the steps. */
+        /* Step on to the next frame, tile, GIF frame or the end,
+         * timing only the steps. */
         uint64_t next = o.steps;
         if (o.every && (t / o.every + 1) * o.every < next) next = (t / o.every + 1) * o.every;
-        if (next_tile < tiles && tile_step[next_tile] < next) next = tile_step[next_tile];
+        if (next_tile < tiles && spread(next_tile, tiles, o.steps) < next) next = spread(next_tile, tiles, o.steps);
+        if (next_gif < gif_frames && spread(next_gif, gif_frames, o.steps) < next) {
+            next = spread(next_gif, gif_frames, o.steps);
+        }
         double t0 = now_s();
         step_world(w, next - t, &o);
         sim_s += now_s() - t0;
@@ -239,6 +278,14 @@ int scene_main(const scene *s, int argc, char **argv) {
     png_write(path, &sheet, (int)o.png_level);
     png_s += now_s() - t0;
     printf("sheet: %s size=%ux%u tiles=%u\n", path, (unsigned)sheet.width, (unsigned)sheet.height, (unsigned)tiles);
+    if (gif) {
+        t0 = now_s();
+        snprintf(path, path_len, "%s/%s.gif", o.out, o.name);
+        gif_written g = gif_write(gif, path, GIF_DELAY_CS, GIF_LAST_DELAY_CS);
+        printf("gif: %s size=%ux%u frames=%u colours=%u bytes=%ld in %.1f ms\n", path, (unsigned)gif_frame.width,
+               (unsigned)gif_frame.height, (unsigned)g.frames, (unsigned)g.colours, g.bytes, 1e3 * (now_s() - t0));
+        gif_free(gif);
+    }
 
     mpca_check(mpca_world_stats(w, &stats), "mpca_world_stats");
     uint64_t hash = 0;
@@ -257,6 +304,7 @@ int scene_main(const scene *s, int argc, char **argv) {
     free(path);
     image_free(&frame);
     image_free(&sheet);
+    image_free(&gif_frame);
     free(frame_gl);
     free(tile_gl);
     canvas_destroy(c);
