@@ -33,6 +33,9 @@ static void usage(const scene *s, FILE *f) {
             "  --density N 2D: the density in bins of N x N cells, uploaded as a texture and\n"
             "              drawn as grey haze under the particles; 0 for none (default %u)\n"
             "  --png-level N  PNG compression, 0 (none) to 9 (smallest, slowest; default %d)\n"
+            "  --progress  report progress on stderr every 10 %% of the steps\n"
+            "  --quiet     no progress report (the default reports it when stderr is a\n"
+            "              terminal, once the run has taken a second)\n"
             "  --version   print the program's and libmpca's versions and exit\n"
             "  --help      print this and exit\n",
             s->name, s->title, s->about, (unsigned)d->size, (unsigned long long)d->steps,
@@ -56,6 +59,7 @@ int options_parse(const scene *s, scene_opts *o, int argc, char **argv) {
     o->name = s->name;
     o->png_level = DEFAULT_PNG_LEVEL;
     o->gif = DEFAULT_GIF_FRAMES;
+    o->progress = PROGRESS_AUTO;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
@@ -65,6 +69,10 @@ int options_parse(const scene *s, scene_opts *o, int argc, char **argv) {
         if (strcmp(a, "--version") == 0) {
             printf("%s (libmpca %s)\n", s->name, mpca_version());
             return 0;
+        }
+        if (strcmp(a, "--progress") == 0 || strcmp(a, "--quiet") == 0) {
+            o->progress = a[2] == 'p' ? PROGRESS_ALWAYS : PROGRESS_NEVER;
+            continue;
         }
         const char *value = i + 1 < argc ? argv[i + 1] : NULL;
         uint64_t v = 0;

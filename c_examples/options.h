@@ -24,7 +24,12 @@ typedef struct scene_opts {
     uint32_t png_level; /* zlib compression level of the PNGs, 0 to 9 */
     uint32_t density; /* 2D: the density as haze in bins of this many cells; 0: none */
     uint32_t gif;     /* frames in the animated GIF; 0: no GIF */
+    int progress;     /* PROGRESS_* */
 } scene_opts;
+
+/* Progress on stderr: never (--quiet), always (--progress), or when stderr
+ * is a terminal and the run has taken a second (the default). */
+enum { PROGRESS_NEVER, PROGRESS_AUTO, PROGRESS_ALWAYS };
 
 #define DEFAULT_GIF_FRAMES 40
 #define MAX_GIF_FRAMES 1000

@@ -11,6 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "common.h"
 #include "gif.h"
@@ -162,6 +163,41 @@ static uint64_t spread(uint64_t i, uint64_t n, uint64_t steps) {
     return n <= 1 ? steps : (steps * i + (n - 1) / 2) / (n - 1);
 }
 
+/* ---- progress on stderr ------------------------------------------------------- */
+
+typedef struct progress {
+    int mode;          /* PROGRESS_*, PROGRESS_NEVER when nothing will be said */
+    double start;
+    uint32_t next;     /* the next tenth to report, 1 to 10; 11: done */
+} progress;
+
+static progress progress_start(int mode) {
+    if (mode == PROGRESS_AUTO && !isatty(STDERR_FILENO)) mode = PROGRESS_NEVER;
+    progress p = {mode, now_s(), 1};
+    return p;
+}
+
+/* The step at which tenth `k` is reached: ceil(k * steps / 10). */
+static uint64_t tenth_step(uint32_t k, uint64_t steps) {
+    return (steps * k + 9) / 10;
+}
+
+/* Reports the highest tenth reached at step t, once; in the automatic
+ * mode only once the run has taken a second, so short runs say nothing. */
+static void progress_report(progress *p, const char *name, uint64_t t, uint64_t steps) {
+    if (p->mode == PROGRESS_NEVER || p->next > 10 || t < tenth_step(p->next, steps)) return;
+    while (p->next <= 10 && t >= tenth_step(p->next, steps)) p->next++;
+    double elapsed = now_s() - p->start;
+    if (p->mode == PROGRESS_AUTO && elapsed < 1.0) return;
+    fprintf(stderr, "%s: %u %% (step %llu of %llu, %.1f s)\n", name, 10 * (p->next - 1), (unsigned long long)t,
+            (unsigned long long)steps, elapsed);
+}
+
+/* The next step after t where a tenth is reached, or UINT64_MAX. */
+static uint64_t progress_next(const progress *p, uint64_t steps) {
+    return p->mode == PROGRESS_NEVER || p->next > 10 ? UINT64_MAX : tenth_step(p->next, steps);
+}
+
 /* ---- the run -------------------------------------------------------------------- */
 
 int scene_main(const scene *s, int argc, char **argv) {
@@ -216,6 +252,7 @@ int scene_main(const scene *s, int argc, char **argv) {
     double sim_s = 0.0, draw_s = 0.0, png_s = 0.0;
     /* pngs: the frames and the sheet */
     uint64_t images = 0, pngs = 1, frames = 0, next_tile = 0, next_gif = 0;
+    progress prog = progress_start(o.progress);
     for (uint64_t t = 0;;) {
         char label[32];
         snprintf(label, sizeof label, "t=%llu", (unsigned long long)t);
@@ -259,8 +296,9 @@ int scene_main(const scene *s, int argc, char **argv) {
             }
         }
         fflush(stdout);
+        progress_report(&prog, o.name, t, o.steps);
         if (t >= o.steps) break;
-        /* Step on to the next frame, tile, GIF frame or the end,
+        /* Step on to the next frame, tile, GIF frame, tenth or the end,
          * timing only the steps. */
         uint64_t next = o.steps;
         if (o.every && (t / o.every + 1) * o.every < next) next = (t / o.every + 1) * o.every;
@@ -268,6 +306,7 @@ int scene_main(const scene *s, int argc, char **argv) {
         if (next_gif < gif_frames && spread(next_gif, gif_frames, o.steps) < next) {
             next = spread(next_gif, gif_frames, o.steps);
         }
+        if (progress_next(&prog, o.steps) < next) next = progress_next(&prog, o.steps);
         double t0 = now_s();
         step_world(w, next - t, &o);
         sim_s += now_s() - t0;

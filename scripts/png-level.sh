@@ -27,7 +27,7 @@ run_all() { # LEVEL DIR: the six runs; prints the total milliseconds spent writi
             smoke-long) args=(smoke --steps 480 --every 40 --name smoke-long) ;;
             *) args=("$run") ;;
         esac
-        line=$("$bin/${args[0]}" "${args[@]:1}" --png-level "$level" --gif 0 --out "$dir" | grep '^sim: ')
+        line=$("$bin/${args[0]}" "${args[@]:1}" --png-level "$level" --gif 0 --quiet --out "$dir" | grep '^sim: ')
         ms=$(echo "$line" | awk -v ms="$ms" '{ for (i = 1; i <= NF; i++) if ($i == "png:") { per = $(i + 1); files = $(i + 3) } }
             END { gsub(/\(/, "", files); printf "%.1f", ms + per * files }')
     done

@@ -25,7 +25,7 @@ while [ $# -gt 0 ]; do
     case "$1" in
         --out) [ $# -ge 2 ] || { echo "--out needs a folder" >&2; exit 2; }; out=$2; shift 2 ;;
         --docs) docs=1; shift ;;
-        -h|--help) sed -n '2,17p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+        -h|--help) sed -n '2,18p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
         *) echo "unknown option: $1 (try --help)" >&2; exit 2 ;;
     esac
 done
@@ -173,7 +173,9 @@ if [ "$docs" -eq 1 ]; then
         echo "the smoke scene a second time, for 480 steps, and with flow drag) and prints where the images"
         echo "are: \`out/scenes/\`. Each program also runs alone, e.g."
         echo "\`target/c_examples/water --size 32 --steps 200 --every 20 --out /tmp/w\`;"
-        echo "\`--help\` lists its options (\`--size --steps --seed --every --tiles --px --out --name --threads --density --gif --png-level --version\`)."
+        echo "\`--help\` lists its options (\`--size --steps --seed --every --tiles --px --out --name --threads --density --gif --png-level --progress --quiet --version\`);"
+        echo "on a terminal, a run that takes over a second reports its progress on"
+        echo "stderr every 10 % (\`--quiet\` turns that off)."
         echo
         for run in "${runs[@]}"; do
             echo "**$(section "$run")**: $(caption "$run")"

@@ -364,6 +364,42 @@ fn water_small_run_draws_the_sphere_the_box_and_the_water() {
     check_small_run("water", 32, 40, 10, Fixed::AtStepZero(0.5));
 }
 
+/// Progress: `--progress` reports on stderr at each tenth of the steps, in
+/// order, up to 100 %; `--quiet`, and the default when stderr is not a
+/// terminal (as here), say nothing. The world ends the same either way,
+/// though with progress the steps are taken in tenths.
+#[test]
+fn progress_reports_tenths_on_stderr_and_changes_nothing() {
+    let out_dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("examples").join("progress");
+    let out_s = out_dir.to_string_lossy().into_owned();
+    let args = ["--size", "32", "--steps", "95", "--every", "0", "--tiles", "1", "--gif", "0", "--out", &out_s];
+    let mut ends = Vec::new();
+    for extra in [&[][..], &["--progress"], &["--quiet"], &["--progress", "--quiet"]] {
+        let out = Command::new(programs().join("aggregation")).args(args).args(extra).output().expect("runs");
+        assert!(out.status.success(), "aggregation {extra:?}: {}", String::from_utf8_lossy(&out.stderr));
+        let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+        if extra == ["--progress"] {
+            let reported: Vec<(u64, u64)> = stderr
+                .lines()
+                .map(|l| {
+                    let rest = l.strip_prefix("aggregation: ").unwrap_or_else(|| panic!("`{l}`"));
+                    let (pct, rest) = rest.split_once(" % (step ").unwrap_or_else(|| panic!("`{l}`"));
+                    let step = rest.split_whitespace().next().unwrap();
+                    (pct.parse().unwrap(), step.parse().unwrap())
+                })
+                .collect();
+            // Tenth k is reached at step ceil(95 k / 10).
+            let expected: Vec<(u64, u64)> = (1..=10u64).map(|k| (10 * k, (95 * k).div_ceil(10))).collect();
+            assert_eq!(reported, expected, "{stderr}");
+        } else {
+            assert!(stderr.is_empty(), "{extra:?} should report nothing:\n{stderr}");
+        }
+        let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+        ends.push(stdout.lines().find(|l| l.starts_with("end: ")).expect("an end: line").to_string());
+    }
+    assert!(ends.iter().all(|e| e == &ends[0]), "{ends:#?}");
+}
+
 /// `--density N`: the density uploaded into a texture and drawn as haze
 /// under the particles (c_examples/gpu.c). The haze is grey, so the
 /// particles' pixels stay exactly theirs; where nothing is near it is the
@@ -445,7 +481,7 @@ fn every_program_documents_and_checks_its_options() {
     for scene in ["aggregation", "cluster", "smoke", "water"] {
         let help = run(scene, &["--help"]);
         for option in
-            ["--size N", "--steps N", "--seed N", "--every N", "--tiles N", "--px N", "--out DIR", "--name S", "--threads N", "--density N", "--png-level N", "--gif N", "--version"]
+            ["--size N", "--steps N", "--seed N", "--every N", "--tiles N", "--px N", "--out DIR", "--name S", "--threads N", "--density N", "--png-level N", "--gif N", "--progress", "--quiet", "--version"]
         {
             assert!(help.contains(option), "{scene} --help does not mention {option}:\n{help}");
         }
