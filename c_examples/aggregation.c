@@ -7,7 +7,7 @@
  */
 #include <math.h>
 
-#include "render.h"
+#include "scene.h"
 
 #define PAPER_SIZE 128
 #define DENSITY 0.3f

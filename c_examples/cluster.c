@@ -5,7 +5,7 @@
  * The same scene as tests/src/scenes.rs `cluster()`; at another --size the
  * discs' centres and radius scale with it.
  */
-#include "render.h"
+#include "scene.h"
 
 #define PAPER_SIZE 128
 #define SPEED 0.8f

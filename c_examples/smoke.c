@@ -12,7 +12,7 @@
  */
 #include <math.h>
 
-#include "render.h"
+#include "scene.h"
 
 /* Built a second time with -DSMOKE_FLOW as `smoke-flow` (M5.1b, beyond the
  * paper; tests/src/scenes.rs `smoke_flow()`): the same emitter and vortex
@@ -134,7 +134,8 @@ int main(int argc, char **argv) {
         .name = "smoke-flow",
         .title = "4.3 smoke with flow drag (M5.1b)",
         .dim = 2,
-        .defaults = {.size = PAPER_SIZE, .steps = 1200, .seed = 43, .every = 100, .tiles = 6, .px = 512},
+        /* The density drawn as haze: smoke as a renderer would show it. */
+        .defaults = {.size = PAPER_SIZE, .steps = 1200, .seed = 43, .every = 100, .tiles = 6, .px = 512, .density = 8},
         .about = "buoyant smoke dragged towards a Rankine vortex flow: it rises at its terminal speed and rolls up",
         .build = build,
         .draw = draw,

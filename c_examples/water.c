@@ -13,7 +13,7 @@
  */
 #include <math.h>
 
-#include "render.h"
+#include "scene.h"
 
 #define PAPER_SIZE 64
 

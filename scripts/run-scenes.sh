@@ -2,18 +2,20 @@
 # The paper's four scenes, rendered: installs what is missing (Debian or
 # Ubuntu), builds libmpca and the C programs of c_examples/, runs the four
 # scenes at full size (and the smoke scene a second, longer time, and with
-# flow drag, M5.1b), and says
-# where the images are and how long the simulation took.
+# flow drag, M5.1b), and says where the images (PNG frames, contact sheets,
+# animated GIFs) are and how long the simulation took.
 #
 #   scripts/run-scenes.sh [--out DIR] [--docs]
 #
 #   --out DIR   where the images go (default out/scenes, git-ignored)
-#   --docs      also copy the contact sheets to docs/scenes/ and rewrite
-#               the README's scenes section (between its <!-- scenes:begin -->
-#               and <!-- scenes:end --> lines) with this machine's timings
+#   --docs      also copy the contact sheets and the GIFs to docs/scenes/
+#               (each at most 300 KB) and rewrite the README's scenes
+#               section (between its <!-- scenes:begin --> and
+#               <!-- scenes:end --> lines) with this machine's timings
 #
-# Needs only the Rust toolchain; make, libosmesa6-dev and libpng-dev are
-# installed with apt-get when missing (as root, or through sudo).
+# Needs only the Rust toolchain; make, libosmesa6-dev, libpng-dev and
+# libgif-dev are installed with apt-get when missing (as root, or through
+# sudo).
 set -euo pipefail
 
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -23,7 +25,7 @@ while [ $# -gt 0 ]; do
     case "$1" in
         --out) [ $# -ge 2 ] || { echo "--out needs a folder" >&2; exit 2; }; out=$2; shift 2 ;;
         --docs) docs=1; shift ;;
-        -h|--help) sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+        -h|--help) sed -n '2,18p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
         *) echo "unknown option: $1 (try --help)" >&2; exit 2 ;;
     esac
 done
@@ -49,13 +51,21 @@ echo "== the scenes, full size, images in $out"
 logs=$(mktemp -d)
 trap 'rm -rf "$logs"' EXIT
 runs=(aggregation cluster smoke water smoke-long smoke-flow)
-for run in "${runs[@]}"; do
-    case "$run" in
+# Images to be checked in are compressed harder: size matters there, the
+# time does not.
+png=()
+[ "$docs" -eq 0 ] || png=(--png-level 9)
+# The program and arguments of a run, into the array `args`.
+run_args() {
+    case "$1" in
         smoke-long) args=(smoke --steps 480 --every 40 --name smoke-long) ;;
-        *) args=("$run") ;;
+        *) args=("$1") ;;
     esac
+}
+for run in "${runs[@]}"; do
+    run_args "$run"
     echo "-- ${args[*]}"
-    "$bin/${args[0]}" "${args[@]:1}" --out "$out" | tee "$logs/$run.log"
+    "$bin/${args[0]}" "${args[@]:1}" "${png[@]}" --out "$out" | tee "$logs/$run.log"
 done
 
 # One row per run: the program's own figures.
@@ -80,7 +90,7 @@ summary | while IFS='|' read -r run cells particles steps per_step total sheet; 
     printf '%-12s %-8s %10s %6s %10s %10s  %s\n' "$run" "$cells" "$particles" "$steps" "$per_step" "$total" "$sheet"
 done
 echo
-echo "frames and contact sheets: $out"
+echo "frames (NAME-frame-0000.png, ...), contact sheets (NAME-sheet.png) and animations (NAME.gif): $out"
 
 if [ "$docs" -eq 1 ]; then
     echo "== docs/scenes and the README's scenes section"
@@ -94,14 +104,30 @@ if [ "$docs" -eq 1 ]; then
             px=$((px / 2))
             small="$logs/px$px"
             case "$run" in
-                smoke-long) "$bin/smoke" --steps 480 --every 0 --name smoke-long --px $px --out "$small" >/dev/null ;;
-                smoke-flow) "$bin/smoke-flow" --every 0 --px $px --out "$small" >/dev/null ;;
-                *) "$bin/$run" --every 0 --px $px --out "$small" >/dev/null ;;
+                smoke-long) "$bin/smoke" --steps 480 --every 0 --name smoke-long --px $px "${png[@]}" --out "$small" >/dev/null ;;
+                smoke-flow) "$bin/smoke-flow" --every 0 --px $px "${png[@]}" --out "$small" >/dev/null ;;
+                *) "$bin/$run" --every 0 --px $px "${png[@]}" --out "$small" >/dev/null ;;
             esac
             sheet="$small/$run-sheet.png"
         done
         cp "$sheet" "$root/docs/scenes/$run.png"
         echo "docs/scenes/$run.png: $(stat -c %s "$sheet") bytes"
+        # The GIF, with fewer frames while it is over 300 KB: its size grows
+        # with the frames, since every frame stores what changed.
+        gif="$out/$run.gif"
+        gif_line=$(grep '^gif: ' "$logs/$run.log")
+        frames=$(echo "$gif_line" | sed 's/.* frames=\([0-9]*\).*/\1/')
+        while [ "$(stat -c %s "$gif")" -gt 307200 ] && [ "$frames" -gt 8 ]; do
+            frames=$((frames * 300 * 1024 / $(stat -c %s "$gif")))
+            [ "$frames" -ge 8 ] || frames=8
+            fewer="$logs/gif$frames"
+            run_args "$run"
+            gif_line=$("$bin/${args[0]}" "${args[@]:1}" --every 0 --tiles 1 --gif "$frames" --out "$fewer" | grep '^gif: ')
+            gif="$fewer/$run.gif"
+        done
+        cp "$gif" "$root/docs/scenes/$run.gif"
+        echo "docs/scenes/$run.gif: $(stat -c %s "$gif") bytes, $frames frames"
+        echo "$frames|$(stat -c %s "$gif")" > "$logs/$run.gif-info"
     done
     paper_s() { case "$1" in aggregation) echo 800;; cluster) echo 70;; smoke) echo 8;; water) echo 270;; *) echo "";; esac; }
     section() { case "$1" in aggregation) echo "4.1 aggregation";; cluster) echo "4.2 cluster collision";;
@@ -113,7 +139,7 @@ if [ "$docs" -eq 1 ]; then
         smoke) echo "one particle a step rises from the ground and the vortex (grey guides) bends the plume;";;
         water) echo "water poured on the sphere splashes off it and spreads over the floor;";;
         smoke-long) echo "the same smoke for 480 steps: the vortex bends the plume round its right side and flings it out at the top right;";;
-        smoke-flow) echo "the smoke as buoyancy plus drag towards the vortex's flow, 1,200 steps: it rises at its terminal speed (slow colours, no clamp) and is carried up round the vortex's right side instead of being flung out; it does not wind into the core, since its rise (0.08 cells a step) is over half the flow's speed at the core (0.14).";;
+        smoke-flow) echo "the smoke as buoyancy plus drag towards the vortex's flow, 1,200 steps: it rises at its terminal speed (slow colours, no clamp) and is carried up round the vortex's right side instead of being flung out; it does not wind into the core, since its rise (0.08 cells a step) is over half the flow's speed at the core (0.14). Its density, in bins of 8 × 8 cells, is drawn as grey haze under the particles.";;
     esac; }
     # 12345 -> 12,345
     commas() { echo "$1" | sed ':a;s/\B[0-9]\{3\}\>/,&/;ta'; }
@@ -123,10 +149,18 @@ if [ "$docs" -eq 1 ]; then
         echo "The four scenes of the paper's section 4, as C programs in \`c_examples/\`"
         echo "that use only \`include/mpca.h\` and \`libmpca\`, drawn off-screen with OpenGL"
         echo "through OSMesa (no window, no display) and written as PNG with libpng."
+        echo "The particles take the path a real-time engine would: the library exports"
+        echo "their positions and velocities straight into a vertex buffer object, and"
+        echo "GLSL 1.20 shaders draw them; the density goes into a texture"
+        echo "(\`c_examples/gpu.c\`, OpenGL 2.1, so also OpenGL ES 2 and WebGL)."
         echo "Particles are coloured by speed (2D: blue slow, through green and yellow,"
         echo "to red at 1 cell per step; 3D: dark blue to light cyan, darker farther"
         echo "away); walls, the sphere and the vortex's guide circles are grey."
-        echo "Each program writes a frame every few steps and one contact sheet:"
+        echo "Each program writes a PNG frame every few steps, numbered in order"
+        echo "(\`water-frame-0000.png\`, \`water-frame-0001.png\`, ..., so tools that read"
+        echo "sequences, such as \`ffmpeg -i water-frame-%04d.png\`, take them as they are),"
+        echo "a contact sheet and an animated GIF (written with giflib, 40 frames at the"
+        echo "sheet's size, one 255-colour palette, each frame storing only what changed):"
         echo
         echo "<!-- scenes: the main command -->"
         echo '```sh'
@@ -134,17 +168,22 @@ if [ "$docs" -eq 1 ]; then
         echo '```'
         echo
         echo "It installs what is missing (\`make\`, \`libosmesa6-dev\`, \`libpng-dev\`,"
-        echo "with \`apt-get\` as root or through \`sudo\`), builds \`libmpca\` in release"
+        echo "\`libgif-dev\`, with \`apt-get\` as root or through \`sudo\`), builds \`libmpca\` in release"
         echo "mode and the programs with \`make\`, runs the four scenes at full size (and"
         echo "the smoke scene a second time, for 480 steps, and with flow drag) and prints where the images"
         echo "are: \`out/scenes/\`. Each program also runs alone, e.g."
         echo "\`target/c_examples/water --size 32 --steps 200 --every 20 --out /tmp/w\`;"
-        echo "\`--help\` lists its options (\`--size --steps --seed --every --tiles --px --out --name --threads --version\`)."
+        echo "\`--help\` lists its options (\`--size --steps --seed --every --tiles --px --out --name --threads --density --gif --png-level --progress --quiet --version\`);"
+        echo "on a terminal, a run that takes over a second reports its progress on"
+        echo "stderr every 10 % (\`--quiet\` turns that off)."
         echo
         for run in "${runs[@]}"; do
             echo "**$(section "$run")**: $(caption "$run")"
             echo
             echo "![$(section "$run"): contact sheet](docs/scenes/$run.png)"
+            echo
+            IFS='|' read -r frames bytes < "$logs/$run.gif-info"
+            echo "Animated: [\`docs/scenes/$run.gif\`](docs/scenes/$run.gif) ($frames frames, $((bytes / 1024)) KB)"
             echo
         done
         echo "Simulation time only (\`mpca_world_step\`; building the world, drawing and"

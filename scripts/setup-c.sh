@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Makes sure the C side can build: a C and a C++ compiler, make, and the
-# OSMesa and libpng headers the rendered scenes (c_examples/) use; installs
-# what is missing (scripts/install-missing.sh).
+# OSMesa, libpng and giflib headers the rendered scenes (c_examples/) use;
+# installs what is missing (scripts/install-missing.sh).
 set -euo pipefail
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 cc=${CC:-cc}
@@ -10,14 +10,15 @@ missing=()
 command -v make >/dev/null 2>&1 || missing+=(make)
 command -v "$cxx" >/dev/null 2>&1 || missing+=(g++)
 if ! command -v "$cc" >/dev/null 2>&1; then
-    missing+=(gcc libc6-dev libosmesa6-dev libpng-dev)
+    missing+=(gcc libc6-dev libosmesa6-dev libpng-dev libgif-dev)
 else
     header() { printf '#include <%s>\n' "$1" | "$cc" -E -x c - >/dev/null 2>&1; }
     header GL/osmesa.h || missing+=(libosmesa6-dev)
     header png.h || missing+=(libpng-dev)
+    header gif_lib.h || missing+=(libgif-dev)
 fi
 if [ ${#missing[@]} -gt 0 ]; then
     "$here/install-missing.sh" "${missing[@]}"
 else
-    echo "make, $cc, $cxx, OSMesa and libpng headers: present"
+    echo "make, $cc, $cxx, OSMesa, libpng and giflib headers: present"
 fi

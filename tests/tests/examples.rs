@@ -4,9 +4,10 @@
 //! back through `pngstat` (c_examples/pngstat.c, also libpng), so this
 //! needs no image crate.
 //!
-//! - Each program runs a few steps at a small size; every frame and the
-//!   contact sheet must have the size the program printed, and the pixels
-//!   must account for the particles it reported (bands derived below).
+//! - Each program runs a few steps at a small size; every frame, the
+//!   contact sheet and the animated GIF must have the size the program
+//!   printed, frames must be numbered 0, 1, 2, ..., and the pixels must
+//!   account for the particles it reported (bands derived below).
 //! - Each program runs a few steps at the paper's size, and its world's
 //!   hash must equal that of the same scene built by `tests/src/scenes.rs`:
 //!   the C scenes are the Rust scenes, placement and seeds included.
@@ -29,7 +30,7 @@ use clib::{library, root};
 use mpca_tests::scenes::{Scene, build, paper_scenes};
 
 /// What to install when the headers are missing (Debian, Ubuntu).
-const INSTALL: &str = "apt-get install -y libosmesa6-dev libpng-dev";
+const INSTALL: &str = "apt-get install -y libosmesa6-dev libpng-dev libgif-dev";
 
 /// The C compiler cc picks for this target.
 fn c_compiler() -> cc::Tool {
@@ -59,19 +60,19 @@ fn check_build_dependencies(cc: &cc::Tool, dir: &Path) {
     let make = Command::new("make").arg("--version").output();
     assert!(
         make.is_ok_and(|o| o.status.success()),
-        "`make` is missing; the C examples need it and the OSMesa and libpng headers: apt-get install -y make \
-         libosmesa6-dev libpng-dev"
+        "`make` is missing; the C examples need it and the OSMesa, libpng and giflib headers: apt-get install -y \
+         make libosmesa6-dev libpng-dev libgif-dev"
     );
     let probe = dir.join("probe.c");
     std::fs::write(
         &probe,
-        "#include <GL/gl.h>\n#include <GL/osmesa.h>\n#include <png.h>\nint main(void) { return 0; }\n",
+        "#include <GL/gl.h>\n#include <GL/osmesa.h>\n#include <png.h>\n#include <gif_lib.h>\nint main(void) { return 0; }\n",
     )
     .expect("write the probe");
     let out = cc.to_command().arg("-fsyntax-only").arg(&probe).output().expect("the C compiler runs");
     assert!(
         out.status.success(),
-        "the C examples need the OSMesa and libpng headers, which {} cannot find: {INSTALL}\n{}",
+        "the C examples need the OSMesa, libpng and giflib headers, which {} cannot find: {INSTALL}\n{}",
         cc.path().display(),
         String::from_utf8_lossy(&out.stderr)
     );
@@ -146,6 +147,8 @@ struct Pixels {
     nonbg: u64,
     /// Pixels in a saturated colour: particles (everything else is grey).
     coloured: u64,
+    /// An animated GIF's frame count (its counts are of the last frame).
+    frames: Option<u64>,
 }
 
 fn pngstat(path: &Path) -> Pixels {
@@ -158,6 +161,7 @@ fn pngstat(path: &Path) -> Pixels {
         height: number(&f, "height", &line),
         nonbg: number(&f, "nonbg", &line),
         coloured: number(&f, "coloured", &line),
+        frames: f.get("frames").map(|v| v.parse().expect("frames")),
     }
 }
 
@@ -249,6 +253,11 @@ fn check_small_run(scene: &str, size: u32, steps: u32, every: u32, fixed: Fixed)
     assert_eq!(tiles.len(), 4, "{scene}: contact sheet tiles");
     assert_eq!((tiles[0].step, tiles[3].step), (0, u64::from(steps)), "{scene}: the sheet spans the run");
 
+    for (i, d) in frames.iter().enumerate() {
+        let name = d.path.as_ref().unwrap().file_name().unwrap().to_string_lossy().into_owned();
+        assert_eq!(name, format!("{scene}-frame-{i:04}.png"), "frames numbered in order, for tools that read sequences");
+    }
+
     let zero = pngstat(frames[0].path.as_ref().unwrap());
     let fixed_px = match fixed {
         Fixed::Nothing => 0,
@@ -306,6 +315,29 @@ fn check_small_run(scene: &str, size: u32, steps: u32, every: u32, fixed: Fixed)
         p.coloured
     );
     assert!(p.nonbg > p.coloured, "{}: no labels or fixed parts drawn", sheet.display());
+
+    // The animated GIF: 40 frames by default, fewer when the run has fewer
+    // steps; the tiles' size plus a label strip; its last frame as shown is
+    // the last tile (step `steps`), whose particles keep their colours
+    // through the palette (gif.c), so the same bounds hold.
+    let gif_line = stdout.lines().find(|l| l.starts_with("gif: ")).expect("a gif: line");
+    let f = fields(gif_line);
+    let gif = PathBuf::from(gif_line["gif: ".len()..].split_whitespace().next().unwrap());
+    assert_eq!(gif, out_dir.join(format!("{scene}.gif")));
+    let g = pngstat(&gif);
+    let expected = u64::from(steps + 1).min(40);
+    assert_eq!(g.frames, Some(expected), "{}: frames", gif.display());
+    assert_eq!(number::<u64>(&f, "frames", gif_line), expected, "{gif_line}");
+    assert_eq!((g.width, g.height), dims(&f, gif_line), "{}: dimensions", gif.display());
+    assert!(g.width == tw && g.height > th, "{}: {}x{} for tiles of {tw}x{th}", gif.display(), g.width, g.height);
+    let (lo, hi) = particle_pixels(&tiles[3]);
+    assert!(
+        (lo..=hi).contains(&g.coloured),
+        "{}: last frame: {} particle pixels, expected {lo}..={hi}",
+        gif.display(),
+        g.coloured
+    );
+    assert!(g.nonbg > g.coloured, "{}: no label drawn", gif.display());
 }
 
 #[test]
@@ -332,6 +364,86 @@ fn water_small_run_draws_the_sphere_the_box_and_the_water() {
     check_small_run("water", 32, 40, 10, Fixed::AtStepZero(0.5));
 }
 
+/// Progress: `--progress` reports on stderr at each tenth of the steps, in
+/// order, up to 100 %; `--quiet`, and the default when stderr is not a
+/// terminal (as here), say nothing. The world ends the same either way,
+/// though with progress the steps are taken in tenths.
+#[test]
+fn progress_reports_tenths_on_stderr_and_changes_nothing() {
+    let out_dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("examples").join("progress");
+    let out_s = out_dir.to_string_lossy().into_owned();
+    let args = ["--size", "32", "--steps", "95", "--every", "0", "--tiles", "1", "--gif", "0", "--out", &out_s];
+    let mut ends = Vec::new();
+    for extra in [&[][..], &["--progress"], &["--quiet"], &["--progress", "--quiet"]] {
+        let out = Command::new(programs().join("aggregation")).args(args).args(extra).output().expect("runs");
+        assert!(out.status.success(), "aggregation {extra:?}: {}", String::from_utf8_lossy(&out.stderr));
+        let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+        if extra == ["--progress"] {
+            let reported: Vec<(u64, u64)> = stderr
+                .lines()
+                .map(|l| {
+                    let rest = l.strip_prefix("aggregation: ").unwrap_or_else(|| panic!("`{l}`"));
+                    let (pct, rest) = rest.split_once(" % (step ").unwrap_or_else(|| panic!("`{l}`"));
+                    let step = rest.split_whitespace().next().unwrap();
+                    (pct.parse().unwrap(), step.parse().unwrap())
+                })
+                .collect();
+            // Tenth k is reached at step ceil(95 k / 10).
+            let expected: Vec<(u64, u64)> = (1..=10u64).map(|k| (10 * k, (95 * k).div_ceil(10))).collect();
+            assert_eq!(reported, expected, "{stderr}");
+        } else {
+            assert!(stderr.is_empty(), "{extra:?} should report nothing:\n{stderr}");
+        }
+        let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+        ends.push(stdout.lines().find(|l| l.starts_with("end: ")).expect("an end: line").to_string());
+    }
+    assert!(ends.iter().all(|e| e == &ends[0]), "{ends:#?}");
+}
+
+/// `--density N`: the density uploaded into a texture and drawn as haze
+/// under the particles (c_examples/gpu.c). The haze is grey, so the
+/// particles' pixels stay exactly theirs; where nothing is near it is the
+/// background, so the frame at step 0 (no particle yet) shows the fixed
+/// parts only, as without haze; once smoke has risen it covers more than
+/// the particles and the fixed parts.
+#[test]
+fn density_haze_is_grey_background_where_empty_and_under_the_particles() {
+    let out_dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("examples").join("density");
+    let _ = std::fs::remove_dir_all(&out_dir);
+    let out_s = out_dir.to_string_lossy().into_owned();
+    let common =
+        ["--size", "32", "--steps", "60", "--every", "30", "--tiles", "2", "--px", "256", "--gif", "0", "--out", &out_s];
+    let runs: Vec<Vec<Drawn>> = [("plain", "0"), ("haze", "4")]
+        .iter()
+        .map(|(name, bin)| {
+            let mut args = common.to_vec();
+            args.extend(["--name", name, "--density", bin]);
+            let stdout = run("smoke-flow", &args);
+            stdout.lines().filter(|l| l.starts_with("frame: ")).map(drawn).collect()
+        })
+        .collect();
+    let (plain, haze) = (&runs[0], &runs[1]);
+    assert_eq!(haze.len(), 3, "frames at 0, 30 and 60");
+    let fixed = pngstat(plain[0].path.as_ref().unwrap());
+    let zero = pngstat(haze[0].path.as_ref().unwrap());
+    assert_eq!((haze[0].particles, zero.nonbg), (0, fixed.nonbg), "step 0: no particle, so no haze");
+    for d in haze {
+        let p = pngstat(d.path.as_ref().unwrap());
+        let (lo, hi) = particle_pixels(d);
+        assert!((lo..=hi).contains(&p.coloured), "{:?}: {} particle pixels, expected {lo}", d.path, p.coloured);
+    }
+    let last = haze.last().unwrap();
+    let p = pngstat(last.path.as_ref().unwrap());
+    assert!(last.particles > 0, "smoke rose");
+    assert!(
+        p.nonbg > p.coloured + fixed.nonbg,
+        "no haze: {} non-background pixels, {} particle pixels, {} fixed",
+        p.nonbg,
+        p.coloured,
+        fixed.nonbg
+    );
+}
+
 /// Each program at the paper's size for a few steps: the same world, bit for
 /// bit (`mpca_world_hash` against `World::state_hash`), as the scene of
 /// tests/src/scenes.rs after the same steps; stepped serially, and in the
@@ -350,7 +462,7 @@ fn the_c_scenes_are_the_rust_scenes() {
         world.step(STEPS);
         for threads in [None, Some("1"), Some("2"), Some("3")] {
             let steps = STEPS.to_string();
-            let mut args = vec!["--steps", &steps, "--every", "0", "--tiles", "1", "--out", &out_s];
+            let mut args = vec!["--steps", &steps, "--every", "0", "--tiles", "1", "--gif", "0", "--out", &out_s];
             args.extend(threads.map(|t| ["--threads", t]).into_iter().flatten());
             let stdout = run(scene.name, &args);
             let line = stdout.lines().find(|l| l.starts_with("end: ")).expect("an end: line");
@@ -369,15 +481,18 @@ fn every_program_documents_and_checks_its_options() {
     for scene in ["aggregation", "cluster", "smoke", "water"] {
         let help = run(scene, &["--help"]);
         for option in
-            ["--size N", "--steps N", "--seed N", "--every N", "--tiles N", "--px N", "--out DIR", "--name S", "--threads N", "--version"]
+            ["--size N", "--steps N", "--seed N", "--every N", "--tiles N", "--px N", "--out DIR", "--name S", "--threads N", "--density N", "--png-level N", "--gif N", "--progress", "--quiet", "--version"]
         {
             assert!(help.contains(option), "{scene} --help does not mention {option}:\n{help}");
         }
-        for bad in [&["--size", "7"][..], &["--steps", "-1"], &["--bogus"], &["--every"], &["--threads", "0"], &["--threads", "17"]] {
+        for bad in [&["--size", "7"][..], &["--steps", "-1"], &["--bogus"], &["--every"], &["--threads", "0"], &["--threads", "17"], &["--png-level", "10"], &["--gif", "1001"]] {
             let out = Command::new(programs().join(scene)).args(bad).output().expect("runs");
             assert_eq!(out.status.code(), Some(2), "{scene} {bad:?} should be refused");
         }
     }
+    // The density haze is 2D only.
+    let out = Command::new(programs().join("water")).args(["--density", "4"]).output().expect("runs");
+    assert_eq!(out.status.code(), Some(2), "water --density 4 should be refused");
 }
 
 /// `c_examples/threads.c`: the 1024^2 gas stepped on 1, 2 and 3 POSIX
