@@ -244,36 +244,35 @@ impl Partition {
         while j < total {
             let i = if reverse { band.end - 1 - j } else { band.start + j };
             let (by, bz) = (i % ay.blocks, i / ay.blocks);
-            // Rows of blocks from i to the band's edge, i included.
-            let room = if reverse { i - band.start + 1 } else { band.end - i };
-            let run = if skip { self.empty_run(idx.rows, by, bz, reverse, room) } else { 0 };
-            if run > 0 {
-                j += run;
-                continue;
-            }
-            j += 1;
             let origin = [ay.first + 2 * by as isize, az.first + 2 * bz as isize];
             let (ys, y_out) = self.axis_pair(1, origin[0]);
             let (zs, z_out) = self.axis_pair(2, origin[1]);
-            let mut row = BlockRow { word: [0; 4], cell: [0; 4], line: [0; 4], outside: 0, origin, index: (i * ax.blocks) as u64 };
-            let mut flagged = false;
+            // The row's domain rows and their flags first; the addresses
+            // only for a row of blocks that is swept.
+            let (mut line, mut outside, mut flagged) = ([0; 4], 0u8, false);
             for dz in 0..layers {
                 for dy in 0..2 {
-                    let r = dy + 2 * dz;
                     if (y_out >> dy | z_out >> dz) & 1 != 0 {
-                        row.outside |= cells_at(1, dy, self.dim) & cells_at(2, dz, self.dim);
+                        outside |= cells_at(1, dy, self.dim) & cells_at(2, dz, self.dim);
                         continue;
                     }
-                    let line = ys[dy] + ay.n * zs[dz];
-                    row.line[r] = line;
-                    row.word[r] = line * self.row_words;
-                    row.cell[r] = line * ax.n;
-                    flagged |= idx.rows.get(line) != 0;
+                    let l = ys[dy] + ay.n * zs[dz];
+                    line[dy + 2 * dz] = l;
+                    flagged |= idx.rows.get(l) != 0;
                 }
             }
             if flagged || !skip {
+                j += 1;
+                let (words, cells) = (line.map(|l| l * self.row_words), line.map(|l| l * ax.n));
+                let row = BlockRow { word: words, cell: cells, line, outside, origin, index: (i * ax.blocks) as u64 };
                 self.sweep_row(sink, idx, &row, reverse, skip);
+                continue;
             }
+            // An empty row of blocks: skip it, and the empty ones after it
+            // four at a time where their flags say so. Rows of blocks from
+            // i to the band's edge, i included.
+            let room = if reverse { i - band.start + 1 } else { band.end - i };
+            j += self.empty_run(idx.rows, by, bz, reverse, room).max(1);
         }
     }
 
