@@ -106,7 +106,7 @@ pub(crate) struct Kernel<'a, Q, const D: usize, const CELLS: usize, const GENERA
 const ROUNDING_MARGIN: [f32; 2] = [core::f32::consts::SQRT_2, 1.732_050_8];
 
 /// Per 2D blocked mask, the part of the table key its cells contribute
-/// (digit 1 each, M5.6).
+/// (digit 1 each, M5.6); twice it for an occupancy mask (digit 2 + m).
 const BLOCKED_KEY_2D: [u16; 16] = {
     let mut t = [0; 16];
     let mut mask = 0;
@@ -158,26 +158,9 @@ const SPREAD_2D: [u32; 256] = {
     t
 };
 
-/// Per 2D occupancy mask, the part of the move table's key (M5.6) that
-/// the occupied cells give whatever they want (digit 2 each).
-const KEY_2D_OCCUPIED: [u16; 16] = {
-    let mut t = [0; 16];
-    let mut mask = 0;
-    while mask < 16 {
-        let mut c = 0;
-        while c < 4 {
-            if mask >> c & 1 != 0 {
-                t[mask] += 2 * PLACE_2D[c];
-            }
-            c += 1;
-        }
-        mask += 1;
-    }
-    t
-};
-
 /// Per 2D wish byte (bits `2c, 2c + 1`: the axes cell `c` wants to cross),
-/// the rest of the key: digit `2 + m` for a particle that wants `c ^ m`.
+/// the part `m` of the key digit `2 + m` of each particle that wants
+/// `c ^ m`; the part 2 is twice [`BLOCKED_KEY_2D`] of the occupied cells.
 const KEY_2D_WANTS: [u16; 256] = {
     let mut t = [0; 256];
     let mut w = 0;
@@ -776,7 +759,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
             let wants = [want & 3, want >> 2 & 3, want >> 4 & 3, want >> 6];
             let mut per_cell = [0u8; CELLS];
             per_cell[..4].copy_from_slice(&wants);
-            let key = usize::from(KEY_2D_OCCUPIED[usize::from(occ)]) + usize::from(KEY_2D_WANTS[usize::from(want)]);
+            let key = 2 * usize::from(BLOCKED_KEY_2D[usize::from(occ)]) + usize::from(KEY_2D_WANTS[usize::from(want)]);
             self.assign(occ, |c| { let x = lane_quanta(lanes, c); dot(x, x) }, 0, &per_cell, key, &mut rng)
         };
 
@@ -1042,7 +1025,7 @@ mod tests {
                     let particle = (occ >> c & 1 != 0).then_some((want >> (2 * c)) as u8 & 3);
                     key += PLACE_2D[c] * digit(true, particle);
                 }
-                assert_eq!(KEY_2D_OCCUPIED[occ] + KEY_2D_WANTS[want], key);
+                assert_eq!(2 * BLOCKED_KEY_2D[occ] + KEY_2D_WANTS[want], key);
             }
         }
     }
