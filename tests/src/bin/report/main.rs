@@ -135,7 +135,7 @@ fn main() {
     };
     write("error-vs-time.svg", &mpca_tests::plot::svg("mpca: error against run time (M10)", &panels, 2));
     write("report.md", &prose::report(&head, &results, &tables));
-    write("report.json", &prose::json(&head, &results, &tables, &panels).pretty());
+    write("report.json", &prose::json(&head, &results, &tables, &panels));
     let section = prose::readme_section(&head, &results);
     if args.publish {
         splice_readme(&section);

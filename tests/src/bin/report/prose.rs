@@ -2,7 +2,7 @@
 //! README section with the recommendations, all from the measured figures.
 
 use mpca::{Drift, Method, Quantization};
-use mpca_tests::json::{obj, Json};
+use serde::{Serialize, Serializer};
 use mpca_tests::measure::{drift_name, method_name, Setting};
 use mpca_tests::plot::{pareto, Panel};
 use mpca_tests::table::{sig, Table};
@@ -338,68 +338,112 @@ pub fn report(h: &Header, r: &Results, tables: &[Table]) -> String {
     s
 }
 
+/// report.json's header: how, where and when the figures were made.
+#[derive(Serialize)]
+struct Meta<'a> {
+    generator: &'static str,
+    mode: &'static str,
+    date: &'a str,
+    cpu: &'a str,
+    logical_processors: usize,
+    usable_threads: usize,
+    os: &'a str,
+    rustc: &'a str,
+    measurement_seconds: f64,
+    timed_runs: usize,
+}
+
+/// The tables by key, in report order.
+struct Tables<'a>(&'a [Table]);
+
+impl Serialize for Tables<'_> {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.collect_map(self.0.iter().map(|t| (t.key, t)))
+    }
+}
+
+/// One panel of the plot with its points.
+#[derive(Serialize)]
+struct PlotPanel<'a> {
+    title: &'a str,
+    x: &'a str,
+    y: &'a str,
+    points: Vec<PlotPoint<'a>>,
+}
+
+#[derive(Serialize)]
+struct PlotPoint<'a> {
+    label: &'a str,
+    x: f64,
+    y: f64,
+    pareto: bool,
+}
+
+/// A cooling gas's temperature, every step.
+#[derive(Serialize)]
+struct Curve<'a> {
+    dim: u32,
+    method: &'static str,
+    drift: &'static str,
+    bits: &'static str,
+    temperature: &'a [f64],
+}
+
+#[derive(Serialize)]
+struct ReportJson<'a> {
+    meta: Meta<'a>,
+    tables: Tables<'a>,
+    plot: Vec<PlotPanel<'a>>,
+    cooling_curves: Vec<Curve<'a>>,
+}
+
 /// report.json.
-pub fn json(h: &Header, r: &Results, tables: &[Table], panels: &[Panel]) -> Json {
+pub fn json(h: &Header, r: &Results, tables: &[Table], panels: &[Panel]) -> String {
     let m = h.machine;
-    let meta = obj([
-        ("generator", "cargo run --release -p mpca-tests --bin report".into()),
-        ("mode", (if h.quick { "quick" } else { "full" }).into()),
-        ("date", m.date.clone().into()),
-        ("cpu", m.cpu.clone().into()),
-        ("logical_processors", m.cores.into()),
-        ("usable_threads", m.parallelism.into()),
-        ("os", m.os.clone().into()),
-        ("rustc", m.rustc.clone().into()),
-        ("measurement_seconds", h.elapsed.into()),
-        ("timed_runs", h.cfg.runs.into()),
-    ]);
-    let tables = Json::Obj(tables.iter().map(|t| (t.key.to_string(), t.json())).collect());
-    let plot = Json::Arr(
-        panels
-            .iter()
-            .map(|p| {
-                let front = pareto(&p.points);
-                obj([
-                    ("title", p.title.clone().into()),
-                    ("x", p.x_label.clone().into()),
-                    ("y", p.y_label.clone().into()),
-                    (
-                        "points",
-                        Json::Arr(
-                            p.points
-                                .iter()
-                                .enumerate()
-                                .map(|(i, q)| {
-                                    obj([
-                                        ("label", q.label.clone().into()),
-                                        ("x", q.x.into()),
-                                        ("y", q.y.into()),
-                                        ("pareto", front.contains(&i).into()),
-                                    ])
-                                })
-                                .collect(),
-                        ),
-                    ),
-                ])
-            })
-            .collect(),
-    );
-    // Cooling curves, every step.
-    let curves = Json::Arr(
-        r.cooling
-            .iter()
-            .map(|c| {
-                obj([
-                    ("dim", u64::from(c.dim).into()),
-                    ("method", method_name(c.setting.method).into()),
-                    ("drift", drift_name(c.setting.drift).into()),
-                    ("bits", mpca_tests::measure::quant_name(c.setting.quant).into()),
-                    ("temperature", c.series.clone().into()),
-                ])
-            })
-            .collect(),
-    );
-    obj([("meta", meta), ("tables", tables), ("plot", plot), ("cooling_curves", curves)])
+    let meta = Meta {
+        generator: "cargo run --release -p mpca-tests --bin report",
+        mode: if h.quick { "quick" } else { "full" },
+        date: &m.date,
+        cpu: &m.cpu,
+        logical_processors: m.cores,
+        usable_threads: m.parallelism,
+        os: &m.os,
+        rustc: &m.rustc,
+        measurement_seconds: h.elapsed,
+        timed_runs: h.cfg.runs,
+    };
+    let plot = panels
+        .iter()
+        .map(|p| {
+            let front = pareto(&p.points);
+            PlotPanel {
+                title: &p.title,
+                x: &p.x_label,
+                y: &p.y_label,
+                points: p
+                    .points
+                    .iter()
+                    .enumerate()
+                    .map(|(i, q)| PlotPoint { label: &q.label, x: q.x, y: q.y, pareto: front.contains(&i) })
+                    .collect(),
+            }
+        })
+        .collect();
+    let cooling_curves = r
+        .cooling
+        .iter()
+        .map(|c| Curve {
+            dim: c.dim,
+            method: method_name(c.setting.method),
+            drift: drift_name(c.setting.drift),
+            bits: mpca_tests::measure::quant_name(c.setting.quant),
+            temperature: &c.series,
+        })
+        .collect();
+    let report = ReportJson { meta, tables: Tables(tables), plot, cooling_curves };
+    let mut text = serde_json::to_string_pretty(&report).expect("the report serialises: every key is a string");
+    text.push('\n');
+    text
 }
 
 /// The README's section: the plot, a summary table and the recommended
