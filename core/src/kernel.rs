@@ -495,7 +495,9 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
 
     /// M5.4: the particle in cell `c` of mass `m` wants the blocked cell
     /// `to`: reflect its velocity off that cell's surface (eq. 9) and clamp
-    /// it. Rare, so kept out of the block routine's straight line.
+    /// it, or keep it where the surface says the particle is already leaving.
+    /// Either way the caller keeps the particle in its cell this step. Rare,
+    /// so kept out of the block routine's straight line.
     #[cold]
     #[inline(never)]
     fn reflect_off(&mut self, b: &mut Block<D, CELLS>, c: usize, to: Wanted, m: f32, rng: &mut Stream) {
@@ -515,11 +517,29 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
             None => (back_normal::<D>(c, t), sh.desc.wall_restitution),
         });
         let x = b.velocity(c);
-        // A normal that does not face the incoming particle (a half-space
-        // seen across a periodic seam, a mask corner) would leave it
-        // pressing on the obstacle for ever: reflect off the face it came
-        // through instead.
-        let n = if dot(x, n) < 0.0 { n } else { back_normal::<D>(c, t) };
+        let back = back_normal::<D>(c, t);
+        let n = if dot(x, n) < 0.0 {
+            n
+        } else {
+            // The particle already leaves the surface (N.v >= 0), yet asks
+            // for one of its cells: a stair of a surface tilted against the
+            // grid. Where N faces the particle's cell, the particle is on
+            // the free side of that surface: it keeps its velocity and only
+            // this move is refused, unless no cell along one axis of its
+            // velocity is free, which would leave it stuck (a concave
+            // corner where shapes overlap). Otherwise, or where N does not
+            // face the particle (a half-space seen across a periodic seam, a
+            // mask corner), it would press on the obstacle for ever: reflect
+            // off the face it came through. M5.4.
+            let mut at = to.at;
+            for (k, a) in at.iter_mut().enumerate().take(D) {
+                *a += ((c >> k) & 1) as i64 - ((t >> k) & 1) as i64;
+            }
+            if dot(n, back) > 0.0 && crate::obstacle::axis_move_free(sh.obstacle, sh.n, &sh.desc.boundary, at, x, D) {
+                return;
+            }
+            back
+        };
         let mut x = reflect(x, n, e); // eq. 9
         clamp_counted(&mut x, Q::SCALE, m, &mut self.counters);
         b.set(c, x);

@@ -168,7 +168,7 @@ impl Layout {
         if u32::try_from(cells).is_err() {
             return Err(Error::TooLarge);
         }
-        let row_words = n[0].div_ceil(64);
+        let row_words = row_words(n[0]);
         let bit_plane = row_words.checked_mul(n[1] * n[2]).and_then(|w| w.checked_mul(8)).ok_or(Error::TooLarge)?;
         // Bit planes are indexed by bit, so their bit count must fit too.
         bit_plane.checked_mul(8).ok_or(Error::TooLarge)?;
@@ -277,6 +277,13 @@ pub(crate) fn mark(rows: Cells<'_, u8>, words: Cells<'_, u64>, summary_words: us
     let w = x >> 6;
     let at = row * summary_words + (w >> 6);
     words.set(at, words.get(at) | 1 << (w & 63));
+}
+
+/// 64-bit words per x-row of a bit plane of `nx` cells per row: rows are
+/// padded to whole words.
+#[inline]
+pub(crate) const fn row_words(nx: usize) -> usize {
+    nx.div_ceil(64)
 }
 
 #[inline]

@@ -10,10 +10,10 @@
 //! obstacle either succeeds whole or changes nothing.
 
 use crate::cells::Cells;
-use crate::desc::{finite, restitution};
+use crate::desc::{finite, restitution, Boundary};
 use crate::partition::{resolve, Beyond};
 use crate::vector::{dot, normalise};
-use crate::layout::{put_bit, Plain};
+use crate::layout::{put_bit, row_words, test_bit, Plain};
 use crate::world::World;
 use crate::Error;
 
@@ -86,6 +86,27 @@ pub(crate) fn reflect(v: [f32; 3], n: [f32; 3], e: f32) -> [f32; 3] {
     }
     let s = (1.0 + e) * vn;
     [v[0] - s * n[0], v[1] - s * n[1], v[2] - s * n[2]]
+}
+
+/// M5.4: whether the particle at `at` (raw coordinates, resolved across the
+/// faces `boundary` of a domain of `n` cells per axis) with velocity `v`
+/// has a cell to go to along a single axis `k` of its velocity (towards
+/// `sign(v_k)`, `v_k != 0`, one of the first `dim` axes) that is neither an
+/// obstacle (bit plane `obstacle`) nor beyond a wall. Such a particle can
+/// always move on later, so refusing it one move leaves it never stuck.
+pub(crate) fn axis_move_free(obstacle: &[u64], n: [usize; 3], boundary: &[[Boundary; 2]; 3], at: [i64; 3], v: [f32; 3], dim: usize) -> bool {
+    (0..dim).any(|k| {
+        if v[k] == 0.0 {
+            return false;
+        }
+        let mut to = at;
+        to[k] += if v[k] > 0.0 { 1 } else { -1 };
+        match resolve(n, boundary, to) {
+            Beyond::Wall(_) => false,
+            Beyond::Open => true,
+            Beyond::Inside(p) => !test_bit(obstacle, (p[1] + n[1] * p[2]) * row_words(n[0]) * 64 + p[0]),
+        }
+    })
 }
 
 /// The surface entry of `cell`, if any, by binary search.

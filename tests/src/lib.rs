@@ -2,7 +2,6 @@
 //! scenes (docs/model.md, paper section 4) built through the public API.
 #![deny(missing_docs)]
 
-pub mod json;
 pub mod measure;
 pub mod plot;
 pub mod scenes;

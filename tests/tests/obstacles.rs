@@ -549,6 +549,78 @@ fn particles_never_stick_across_a_periodic_seam() {
     assert!(turned, "the particle never bounced off the floor's underside");
 }
 
+/// M5.4, a particle leaving a staircase wall: over long runs along walls
+/// tilted 18° to 72° (periodic, so the staircase never ends), particles
+/// sliding along them or leaving at up to 25°, or arriving at grazing
+/// angles, for both drift rules and widths (walls::slide). Expected: every
+/// velocity change is eq. 9 off the wall's normal, to within one quantum
+/// per component (no kick off the face a particle came through, which the
+/// rule before this one gave up to 143° off); the stated worst case, the
+/// largest angle between a stored outgoing velocity and eq. 9's exact one,
+/// stays within what that rounding allows at speed 0.6 (asin(sqrt(2)
+/// quanta / 0.6)); and no particle stays in one cell longer than a
+/// particle free to leave does with probability 1e-9 over the whole run
+/// (the bound comes from the smallest chance of asking for a free cell,
+/// see SlideRow::stay_bound), while never entering an obstacle.
+#[test]
+fn staircase_walls_neither_kick_nor_hold_particles() {
+    for quant in [Quantization::Bits8, Quantization::Bits16] {
+        for drift in [mpca::Drift::Paper, mpca::Drift::Calibrated] {
+            let r = mpca_tests::measure::walls::slide(quant, drift, 1500, 1);
+            let what = format!("{quant:?} {drift:?}");
+            assert_eq!(r.kicks, 0, "{what}: {} kicks, up to {:.1}°", r.kicks, r.worst_kick_deg);
+            assert!(r.reflections > 0, "{what}: no particle met a wall");
+            let rounding = (std::f64::consts::SQRT_2 / common::scale(quant) / 0.6).asin().to_degrees();
+            assert!(r.worst_deg <= rounding, "{what}: {:.3}° against {rounding:.3}°", r.worst_deg);
+            assert!(r.stay_bound < r.steps / 2, "{what}: a bound of {} steps could not tell a stuck particle", r.stay_bound);
+            assert_eq!(r.stuck, 0, "{what}: longest stay {} steps, bound {}", r.longest_stay, r.stay_bound);
+            assert_eq!(r.inside, 0, "{what}");
+        }
+    }
+}
+
+/// M5.4's guard against holding a particle for ever: a particle in a pocket
+/// of three obstacle cells (right, above, diagonal) whose stored normals
+/// all say it is already leaving them (N.v >= 0, as at a concave corner
+/// where shapes overlap with their own normals), with velocity (0.6, 0.3).
+/// Every move it can ask for is into the pocket, and refusing those moves
+/// while keeping its velocity would hold it there for ever; with no free
+/// cell along an axis of its velocity it is reflected off the face it came
+/// through instead. Expected: within 100 steps it has left its cell (it
+/// asks for a move with probability 1 - 0.4 * 0.7 = 0.72 in every other
+/// step, so staying 100 steps by chance has probability below 1e-27), and
+/// it never enters an obstacle.
+#[test]
+fn a_particle_in_a_pocket_of_leaving_normals_is_not_held() {
+    for drift in [mpca::Drift::Paper, mpca::Drift::Calibrated] {
+        let mut desc = world_with_obstacles(Description::new_2d(16, 16));
+        desc.drift = drift;
+        desc.seed = 17;
+        let mut mem = memory(&desc);
+        let world = World::init(&desc, &mut mem).unwrap();
+        let v = [0.6f32, 0.3, 0.0];
+        for (cell, normal) in [([9, 8, 0], [-0.3f32, 0.95, 0.0]), ([8, 9, 0], [0.8, -0.6, 0.0]), ([9, 9, 0], [0.6, -0.8, 0.0])] {
+            let n = unit(normal.map(f64::from));
+            let back = unit([8.0 - f64::from(cell[0]), 8.0 - f64::from(cell[1]), 0.0]);
+            assert!(n[0] * back[0] + n[1] * back[1] > 0.0, "{cell:?}: the normal faces the particle");
+            assert!(n[0] * f64::from(v[0]) + n[1] * f64::from(v[1]) >= 0.0, "{cell:?}: the particle leaves it");
+            world.add_obstacle(cell, normal, 1.0).unwrap();
+        }
+        world.add_particle([8, 8, 0], v).unwrap();
+        let mut left = None;
+        for step in 1..=100 {
+            world.step(1);
+            let p = world.particles().next().expect("walls keep the particle");
+            assert!(!world.obstacle_at(p.pos), "{drift:?}: inside an obstacle at {:?}", p.pos);
+            if p.pos != [8, 8, 0] {
+                left = Some(step);
+                break;
+            }
+        }
+        assert!(left.is_some(), "{drift:?}: held in the pocket for 100 steps");
+    }
+}
+
 /// Round to nearest is symmetric: `v` and `-v` are stored as opposite
 /// integers, halves included (0.5 * 127 = 63.5).
 #[test]

@@ -5,8 +5,9 @@
 //! Reflection: particles fly at a wall from angles of 10 to 70 degrees
 //! to its normal, one per z-plane of a 3D world (planes 4 apart, no speed
 //! along z, so no two share a block and only the wall changes a velocity).
-//! Three walls: the domain's wall face (M4), an axis-aligned half-space
-//! obstacle and a half-space tilted by 30 degrees (M7 normals). For each
+//! Four walls: the domain's wall face (M4), an axis-aligned half-space
+//! obstacle and half-spaces tilted by 30 and 60 degrees (M7 normals; on
+//! the grid they are staircases of cells). For each
 //! particle the first step that changes its velocity is the bounce:
 //! - velocity angles: incoming from the stored velocity before, outgoing
 //!   after (eq. 9 keeps the angle; rounding to storage, M1, moves it);
@@ -33,30 +34,51 @@ pub enum Wall {
     Face,
     /// A half-space obstacle below y = 4 with normal +y.
     Flat,
-    /// A half-space through (32, 16) with normal (sin 30, cos 30).
-    Tilted,
+    /// A half-space through (32, 32) with normal (sin 30, cos 30).
+    Tilted30,
+    /// A half-space through (40, 56) with normal (sin 60, cos 60).
+    Tilted60,
 }
 
 impl Wall {
-    /// All three.
-    pub const ALL: [Wall; 3] = [Wall::Face, Wall::Flat, Wall::Tilted];
+    /// All four.
+    pub const ALL: [Wall; 4] = [Wall::Face, Wall::Flat, Wall::Tilted30, Wall::Tilted60];
+    /// The staircases.
+    pub const TILTED: [Wall; 2] = [Wall::Tilted30, Wall::Tilted60];
 
     /// The report's name.
     pub fn name(self) -> &'static str {
         match self {
             Wall::Face => "wall face",
             Wall::Flat => "flat obstacle",
-            Wall::Tilted => "obstacle tilted 30°",
+            Wall::Tilted30 => "obstacle tilted 30°",
+            Wall::Tilted60 => "obstacle tilted 60°",
+        }
+    }
+
+    /// The tilt from the horizontal, degrees.
+    pub fn tilt(self) -> f64 {
+        match self {
+            Wall::Face | Wall::Flat => 0.0,
+            Wall::Tilted30 => 30.0,
+            Wall::Tilted60 => 60.0,
         }
     }
 
     fn normal(self) -> [f64; 3] {
+        let a = self.tilt().to_radians();
+        [a.sin(), a.cos(), 0.0]
+    }
+
+    /// A point of a tilted wall's surface, and the domain's width and
+    /// height: room for every path to the wall and on along it, so that no
+    /// particle meets the domain's faces or the wall's end first (the flat
+    /// walls run along a periodic x axis instead).
+    fn anchor(self) -> ([f64; 2], [u32; 2]) {
         match self {
-            Wall::Face | Wall::Flat => [0.0, 1.0, 0.0],
-            Wall::Tilted => {
-                let a = 30f64.to_radians();
-                [a.sin(), a.cos(), 0.0]
-            }
+            Wall::Face | Wall::Flat => ([0.0, 0.0], [64, 40]),
+            Wall::Tilted30 => ([32.0, 32.0], [96, 64]),
+            Wall::Tilted60 => ([40.0, 56.0], [96, 96]),
         }
     }
 }
@@ -141,12 +163,19 @@ struct Track {
 impl Wall {
     /// Whether a particle in cell `pos` touches this wall: on the first row
     /// for the wall face, next to an obstacle cell (in its z-plane)
-    /// otherwise. A bounce elsewhere (the domain's floor, reached by a
+    /// otherwise. A bounce elsewhere (the domain's faces, reached by a
     /// particle that skimmed along the obstacle's staircase without
-    /// touching it) does not count.
+    /// touching it) does not count, nor does one in a cell on a wall face
+    /// of the domain, where the face may be what the particle met.
     fn touches(self, world: &World, pos: [i64; 3]) -> bool {
         if self == Wall::Face {
             return pos[1] == 0;
+        }
+        let d = world.description();
+        for (k, &p) in pos.iter().enumerate().take(2) {
+            if (p == 0 || p == i64::from(d.size[k]) - 1) && d.boundary[k][0] == Boundary::Wall {
+                return false;
+            }
         }
         let mut near = false;
         for dy in -1..=1i64 {
@@ -165,36 +194,49 @@ impl Wall {
 /// and the step times.
 pub fn reflect(wall: Wall, quant: Quantization, drift: Drift, per_angle: usize, runs: usize) -> (Vec<ReflectRow>, Timing) {
     let planes = (ANGLES.len() * per_angle) as u32;
-    let mut desc = Description::new_3d(64, 40, 4 * planes);
-    desc.boundary[0] = [Boundary::Wall; 2];
+    let (anchor, [width, height]) = wall.anchor();
+    let mut desc = Description::new_3d(width, height, 4 * planes);
+    let flat = matches!(wall, Wall::Face | Wall::Flat);
+    desc.boundary[0] = [if flat { Boundary::Periodic } else { Boundary::Wall }; 2];
     desc.boundary[1] = [Boundary::Wall; 2];
     desc.quantization = quant;
     desc.drift = drift;
     desc.seed = 80;
     if wall != Wall::Face {
         desc.obstacles = true;
-        desc.surface_capacity = 64 * 8 * 4 * planes;
+        desc.surface_capacity = width * 8 * 4 * planes;
     }
     let n = wall.normal();
     let t = [n[1], -n[0], 0.0];
     let mut mem = memory(&desc);
-    let (tracks, timing) = repeat(runs, || {
+    // The wall is built once and saved (M12): every timed run loads it
+    // back bit for bit, which costs far less than adding the shape to a
+    // domain of a few million cells again.
+    let image = {
         let world: &mut World = World::init(&desc, &mut mem).expect("fits");
         match wall {
             Wall::Face => Ok(()),
             Wall::Flat => world.add_shape(Shape::HalfSpace { point: [0.0, 4.0, 0.0], normal: [0.0, 1.0, 0.0] }, 1.0),
-            Wall::Tilted => {
+            Wall::Tilted30 | Wall::Tilted60 => {
                 let nf = n.map(|c| c as f32);
-                world.add_shape(Shape::HalfSpace { point: [32.0, 16.0, 0.0], normal: nf }, 1.0)
+                world.add_shape(Shape::HalfSpace { point: [anchor[0] as f32, anchor[1] as f32, 0.0], normal: nf }, 1.0)
             }
         }
         .expect("the wall fits");
+        let mut image = vec![0u8; world.snapshot_bytes()];
+        world.save(&mut image).expect("the image fits");
+        image
+    };
+    let (tracks, timing) = repeat(runs, || {
+        let world: &mut World = World::init(&desc, &mut mem).expect("fits");
+        world.load(&image).expect("the world's own image");
         let mut tracks = vec![Track::default(); planes as usize];
         for (j, track) in tracks.iter_mut().enumerate() {
             let a = ANGLES[j / per_angle].to_radians();
             // Into the wall at angle a from -n, on the +t side.
             let v = [0, 1, 2].map(|k| (SPEED * (-a.cos() * n[k] + a.sin() * t[k])) as f32);
-            // Start 6 cells from the wall along n, spread along the tangent
+            // Start 6 cells from the wall along n (from its point at x =
+            // anchor - 12 for the tilted ones), spread along the tangent
             // so both parities of every axis occur. Under the paper's rule
             // a 70 degree path covers at most 3.5 cells along the wall per
             // cell towards it: about 21 cells to the wall, 12 steps after,
@@ -202,7 +244,9 @@ pub fn reflect(wall: Wall, quant: Quantization, drift: Drift, per_angle: usize, 
             let base = match wall {
                 Wall::Face => [4.0, 6.5],
                 Wall::Flat => [4.0, 10.5],
-                Wall::Tilted => [20.0 + 6.0 * n[0], 16.0 + 12.0 * n[0] / n[1] + 6.0 * n[1]],
+                Wall::Tilted30 | Wall::Tilted60 => {
+                    [anchor[0] - 12.0 + 6.0 * n[0], anchor[1] + 12.0 * n[0] / n[1] + 6.0 * n[1]]
+                }
             };
             let shift = (j % per_angle) as f64 * 0.37 + (j / per_angle) as f64 * 0.11;
             let pos = [(base[0] + shift * t[0]).floor() as u32, (base[1] + shift * t[1]).floor() as u32, 4 * j as u32];
@@ -287,6 +331,196 @@ pub fn reflect(wall: Wall, quant: Quantization, drift: Drift, per_angle: usize, 
         });
     }
     (rows, timing)
+}
+
+/// The walls of the sliding runs, as integer normals `(a, b)`: a wall of
+/// cells with `(a x + b y) mod 64 < SLIDE_BAND` repeats on a periodic
+/// domain of 64 cells per axis, so a particle can follow its staircase for
+/// as long as the run lasts. Tilts from the horizontal: 18.4°, 26.6°, 45°,
+/// 63.4° and 71.6°.
+pub const SLIDE_NORMALS: [[i32; 2]; 5] = [[1, 3], [1, 2], [1, 1], [2, 1], [3, 1]];
+/// Width of a sliding wall, in units of `a x + b y`.
+const SLIDE_BAND: i32 = 12;
+/// Directions of the sliding particles from the wall's tangent, degrees:
+/// positive away from the wall, negative into it (a grazing bounce first).
+pub const SLIDE_ANGLES: [f64; 6] = [-10.0, -3.0, 0.0, 3.0, 10.0, 25.0];
+/// Chance allowed to the whole measurement of holding a free particle in
+/// one cell for [`SlideRow::stay_bound`] steps by bad luck alone.
+const STAY_RISK: f64 = 1e-9;
+
+/// Particles sliding along and away from staircase walls for many steps.
+#[derive(Clone, Debug)]
+pub struct SlideRow {
+    /// Storage.
+    pub quant: Quantization,
+    /// Move rule.
+    pub drift: Drift,
+    /// Particles (one per world), steps each.
+    pub particles: usize,
+    /// Steps each particle was followed.
+    pub steps: u64,
+    /// Velocity changes that are eq. 9 off the wall's normal (±n, the
+    /// side the particle came from), to within the rounding to storage:
+    /// every component within one quantum.
+    pub reflections: u64,
+    /// Velocity changes that are not: a turn off any other direction (the
+    /// face a particle came through, before M5.4 kept the velocity of a
+    /// particle already leaving the wall).
+    pub kicks: u64,
+    /// Largest angle between a stored outgoing velocity and eq. 9's exact
+    /// result, over the reflections, degrees (rounding).
+    pub worst_deg: f64,
+    /// Largest angle between a velocity after a kick and before, degrees.
+    pub worst_kick_deg: f64,
+    /// Longest run of steps a particle with a velocity spent in one cell.
+    pub longest_stay: u64,
+    /// The run no particle that can move should reach: a particle leaving
+    /// a wall always has a free cell along one axis of its velocity, which
+    /// it asks for, alone or with a move that stays clear of the wall, with
+    /// probability `q` or more every two steps (M5.3); the bound is the
+    /// run that even the smallest `q` met makes less likely than 1e-9 over
+    /// every particle and step.
+    pub stay_bound: u64,
+    /// Particles whose longest stay exceeded that bound.
+    pub stuck: usize,
+    /// Particle-steps on an obstacle cell (must be 0).
+    pub inside: u64,
+    /// Step times.
+    pub timing: Timing,
+}
+
+/// `q` of [`SlideRow::stay_bound`] for a particle of velocity `v` leaving or
+/// sliding along a wall of unit normal `n` (`v.n >= 0`): the chance that in
+/// the step of the two where it can ask for its free axis `a` (the axis of
+/// the largest move probability among those with `v_a n_a > 0`), it asks
+/// for a move that leaves the wall side no closer: `a` alone, or `a` with
+/// the other axis where that diagonal has a positive component along `n`.
+fn leave_chance(drift: Drift, v: [f64; 3], n: [f64; 3]) -> f64 {
+    let p = |k: usize| super::move_probability(drift, v[k].abs());
+    let Some(a) = (0..2).filter(|&k| v[k] * n[k] > 0.0).max_by(|&i, &j| p(i).total_cmp(&p(j))) else {
+        return 0.0;
+    };
+    let b = 1 - a;
+    let diagonal = v[a].signum() * n[a] + if v[b] == 0.0 { 0.0 } else { v[b].signum() * n[b] };
+    p(a) * (1.0 - p(b)) + if diagonal > 0.0 { p(a) * p(b) } else { 0.0 }
+}
+
+/// Sliding along staircases: per wall of [`SLIDE_NORMALS`] and direction
+/// of [`SLIDE_ANGLES`], both ways along the wall, one particle at speed 0.6
+/// in its own 2D periodic world of 64 x 64 cells, starting next to the
+/// wall, with e = 1, followed for `steps` steps. Every velocity change is
+/// checked against eq. 9 off the wall's normal; the particle crosses the
+/// gap between the walls and meets the next one on the other side too.
+pub fn slide(quant: Quantization, drift: Drift, steps: u64, runs: usize) -> SlideRow {
+    let mut desc = Description::new_2d(64, 64);
+    desc.quantization = quant;
+    desc.drift = drift;
+    desc.obstacles = true;
+    desc.surface_capacity = 64 * 64;
+    let quantum = 1.0 / scale(quant);
+    let mut mem = memory(&desc);
+    let (row, timing) = repeat(runs, || {
+        let mut row = SlideRow {
+            quant,
+            drift,
+            particles: 0,
+            steps,
+            reflections: 0,
+            kicks: 0,
+            worst_deg: 0.0,
+            worst_kick_deg: 0.0,
+            longest_stay: 0,
+            stay_bound: 0,
+            stuck: 0,
+            inside: 0,
+            timing: Timing::default(),
+        };
+        let (mut seconds, mut least_q, mut stays) = (0.0, 1.0f64, vec![]);
+        for (w, &[a, b]) in SLIDE_NORMALS.iter().enumerate() {
+            let len = f64::from(a * a + b * b).sqrt();
+            let n = [f64::from(a) / len, f64::from(b) / len, 0.0];
+            let t = [n[1], -n[0], 0.0];
+            let band = |x: i32, y: i32| (a * x + b * y).rem_euclid(64);
+            for (j, &deg) in SLIDE_ANGLES.iter().enumerate() {
+                for way in [1.0, -1.0] {
+                    desc.seed = 700 + 100 * w as u64 + 2 * j as u64 + u64::from(way < 0.0);
+                    let world: &mut World = World::init(&desc, &mut mem).expect("fits");
+                    for y in 0..64 {
+                        for x in 0..64 {
+                            let s = band(x, y);
+                            if s < SLIDE_BAND {
+                                // The nearer face's normal: +n on the side of
+                                // growing a x + b y.
+                                let side = if s >= SLIDE_BAND / 2 { 1.0 } else { -1.0 };
+                                let nf = n.map(|c| (side * c) as f32);
+                                world.add_obstacle([x as u32, y as u32, 0], nf, 1.0).expect("a wall cell");
+                            }
+                        }
+                    }
+                    // Start in the first free cell past the wall's +n face,
+                    // at a column that differs from particle to particle.
+                    let x0 = (7 * (j as i32 + 6 * w as i32) + if way < 0.0 { 3 } else { 0 }).rem_euclid(64);
+                    let y0 = (0..64).find(|&y| (SLIDE_BAND..SLIDE_BAND + a + b).contains(&band(x0, y))).expect("a free cell");
+                    let r = deg.to_radians();
+                    let v = [0, 1, 2].map(|k| (0.6 * (way * r.cos() * t[k] + r.sin() * n[k])) as f32);
+                    world.add_particle([x0 as u32, y0 as u32, 0], v).expect("a free cell");
+                    row.particles += 1;
+                    let first = world.particles().next().expect("one particle");
+                    let (mut pos, mut vel) = (first.pos, first.velocity.map(f64::from));
+                    let (mut stay, mut longest) = (0u64, 0u64);
+                    for _ in 0..steps {
+                        seconds += super::clock(|| world.step(1));
+                        let p = world.particles().next().expect("a periodic world keeps its particle");
+                        let now = p.velocity.map(f64::from);
+                        row.inside += u64::from(world.obstacle_at(p.pos));
+                        if now != vel {
+                            // The side of the wall the particle came from.
+                            let side = if dot(vel, n) < 0.0 { 1.0 } else { -1.0 };
+                            let m = n.map(|c| side * c);
+                            let vn = dot(vel, m);
+                            let want = [0, 1, 2].map(|k| vel[k] - 2.0 * vn * m[k]);
+                            let rounding = (0..3).all(|k| (now[k] - want[k]).abs() < quantum * (1.0 + 1e-3));
+                            if vn < 0.0 && rounding {
+                                row.reflections += 1;
+                                row.worst_deg = row.worst_deg.max(between(now, want));
+                            } else {
+                                row.kicks += 1;
+                                row.worst_kick_deg = row.worst_kick_deg.max(between(now, vel));
+                            }
+                        }
+                        if p.pos == pos && now != [0.0; 3] {
+                            stay += 1;
+                            longest = longest.max(stay);
+                        } else {
+                            stay = 0;
+                        }
+                        // The leaving chance of the velocity now, off the
+                        // wall it leaves or slides along.
+                        let m = if dot(now, n) >= 0.0 { n } else { n.map(|c| -c) };
+                        if now != [0.0; 3] {
+                            least_q = least_q.min(leave_chance(drift, now, m));
+                        }
+                        (pos, vel) = (p.pos, now);
+                    }
+                    stays.push(longest);
+                }
+            }
+        }
+        // A bounce keeps a particle in its cell one step more than the
+        // leaving chance accounts for: two steps of slack.
+        let windows = (row.particles as u64 * steps) as f64;
+        row.stay_bound = if least_q > 0.0 { 2 * ((STAY_RISK / windows).ln() / (1.0 - least_q).ln()).ceil() as u64 + 2 } else { u64::MAX };
+        row.longest_stay = stays.iter().copied().max().unwrap_or(0);
+        row.stuck = stays.iter().filter(|&&s| s > row.stay_bound).count();
+        (row, seconds)
+    });
+    SlideRow { timing, ..row }
+}
+
+/// The angle between two vectors, degrees.
+fn between(u: [f64; 3], v: [f64; 3]) -> f64 {
+    let c = dot(u, v) / (dot(u, u) * dot(v, v)).sqrt();
+    c.clamp(-1.0, 1.0).acos().to_degrees()
 }
 
 /// Particles found inside obstacles in a busy walled world.

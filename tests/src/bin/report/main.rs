@@ -133,9 +133,10 @@ fn main() {
         std::fs::write(&path, text).unwrap_or_else(|e| panic!("cannot write {}: {e}", path.display()));
         eprintln!("wrote {}", path.display());
     };
-    write("error-vs-time.svg", &mpca_tests::plot::svg("mpca: error against run time (M10)", &panels, 2));
+    let figure = mpca_tests::plot::svg("mpca: error against run time (M10)", &panels, 2).unwrap_or_else(|e| panic!("cannot draw the figure: {e}"));
+    write("error-vs-time.svg", &figure);
     write("report.md", &prose::report(&head, &results, &tables));
-    write("report.json", &prose::json(&head, &results, &tables, &panels).pretty());
+    write("report.json", &prose::json(&head, &results, &tables, &panels));
     let section = prose::readme_section(&head, &results);
     if args.publish {
         splice_readme(&section);

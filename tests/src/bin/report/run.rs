@@ -6,7 +6,7 @@ use mpca_tests::measure::conservation::{self, BoxConfig, BoxResult};
 use mpca_tests::measure::cooling::{self, CoolingConfig, CoolingResult};
 use mpca_tests::measure::drift::{self, DriftConfig, DriftResult};
 use mpca_tests::measure::scenes::{self, LeaveOutRow, SceneRow};
-use mpca_tests::measure::walls::{self, InsideRow, ReflectRow, Wall};
+use mpca_tests::measure::walls::{self, InsideRow, ReflectRow, SlideRow, Wall};
 use mpca_tests::measure::{Setting, Timing, DRIFTS, METHODS, QUANTS};
 use mpca_tests::scenes::paper_scenes;
 
@@ -31,6 +31,8 @@ pub struct Config {
     pub cooling_3d: CoolingConfig,
     /// Particles per incoming angle.
     pub per_angle: usize,
+    /// Steps of each particle sliding along a staircase.
+    pub slide_steps: u64,
     /// Steps of the obstacle-filled box.
     pub inside_steps: u64,
     /// Share of each paper scene's step count that is run.
@@ -52,6 +54,7 @@ impl Config {
             cooling_2d: CoolingConfig { n: 48, steps: 250, runs: 3 },
             cooling_3d: CoolingConfig { n: 16, steps: 150, runs: 3 },
             per_angle: 4,
+            slide_steps: 300,
             inside_steps: 100,
             scene_share: 0.25,
             leave_out_runs: 3,
@@ -70,6 +73,7 @@ impl Config {
             cooling_2d: CoolingConfig { n: 64, steps: 1000, runs: 5 },
             cooling_3d: CoolingConfig { n: 24, steps: 500, runs: 5 },
             per_angle: 32,
+            slide_steps: 2000,
             inside_steps: 500,
             scene_share: 1.0,
             leave_out_runs: 7,
@@ -94,6 +98,8 @@ pub struct Results {
     /// Reflections, per (wall, quantization, rule, angle), with the time
     /// of each (wall, quantization, rule).
     pub reflect: Vec<(Vec<ReflectRow>, Timing)>,
+    /// Particles sliding along staircases, per (quantization, rule).
+    pub slide: Vec<SlideRow>,
     /// Obstacle-filled box, per setting.
     pub inside: Vec<InsideRow>,
     /// Leave out what the scene does not need.
@@ -168,6 +174,12 @@ pub fn all(cfg: &Config) -> Results {
             }
         }
     }
+    let mut slide = vec![];
+    for q in QUANTS {
+        for d in DRIFTS {
+            slide.push(walls::slide(q, d, cfg.slide_steps, cfg.runs));
+        }
+    }
     let mut inside = vec![];
     for m in METHODS {
         for q in [Quantization::Bits8, Quantization::Bits16] {
@@ -182,5 +194,5 @@ pub fn all(cfg: &Config) -> Results {
         leave_out.extend(scenes::leave_out(&scene, steps, cfg.leave_out_runs));
     }
 
-    Results { drift, assign, assign_summary, scenes: scene_rows, boxes, cooling, reflect, inside, leave_out }
+    Results { drift, assign, assign_summary, scenes: scene_rows, boxes, cooling, reflect, slide, inside, leave_out }
 }
