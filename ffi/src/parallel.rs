@@ -42,7 +42,7 @@ pub unsafe extern "C" fn mpca_world_step_parallel(
     run_tasks: mpca_run_tasks,
     user_data: *mut c_void,
 ) -> mpca_status {
-    guard(|| {
+    guard(|_| {
         if world.is_null() {
             return Err(mpca_status::NullPointer);
         }
@@ -88,7 +88,7 @@ pub unsafe extern "C" fn mpca_world_step_parallel(
 /// step is in flight (`MPCA_STATUS_STALE_TASK`). Hosted builds only.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_world_step_task(world: *mut mpca_world, ticket: u64, index: u32) -> mpca_status {
-    guard(|| {
+    guard(|_| {
         if world.is_null() {
             return Err(mpca_status::NullPointer);
         }
