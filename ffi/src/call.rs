@@ -202,6 +202,81 @@ mod tests {
         assert_eq!(unsafe { out.assume_init() }, [4.0, 5.0, 6.0]);
     }
 
+    /// The exports as C uses them, small enough for Miri, which checks
+    /// that every accessor's reference is valid and unaliased while used:
+    /// a world in caller memory and one in library memory, particles, a
+    /// step, the exports, an image saved and built into new memory, and
+    /// the refusals that must not read or write.
+    #[test]
+    fn exports_reach_caller_memory_only_as_promised() {
+        use crate::*;
+        use core::ptr::{null, null_mut};
+        // SAFETY, for every call below: each pointer is NULL or a live
+        // local of the size the header asks for.
+        unsafe {
+            let mut d = core::mem::MaybeUninit::<mpca_desc>::uninit();
+            assert_eq!(mpca_desc_defaults(d.as_mut_ptr(), 2, 8, 6, 0), mpca_status::Ok);
+            let d = d.assume_init();
+            let mut bytes = 0usize;
+            assert_eq!(mpca_world_bytes(&d, &mut bytes), mpca_status::Ok);
+            let mut memory = std::vec![0u8; bytes];
+            let mut w = null_mut();
+            assert_eq!(mpca_world_init(&d, memory.as_mut_ptr().cast(), bytes, &mut w), mpca_status::Ok);
+            let mut owned = null_mut();
+            assert_eq!(mpca_world_create(&d, &mut owned), mpca_status::Ok);
+            for (i, pos) in [[1u32, 1, 0], [4, 2, 0], [7, 5, 0]].iter().enumerate() {
+                let v = [0.5f32, -0.25 * i as f32, 0.0];
+                assert_eq!(mpca_world_add_particle(w, pos.as_ptr(), v.as_ptr()), mpca_status::Ok);
+                assert_eq!(mpca_world_add_particle(owned, pos.as_ptr(), v.as_ptr()), mpca_status::Ok);
+            }
+            assert_eq!(mpca_world_add_particle(w, [1u32, 1, 0].as_ptr(), null()), mpca_status::NullPointer);
+            assert_eq!(mpca_world_step(w, 2), mpca_status::Ok);
+            assert_eq!(mpca_world_step(owned, 2), mpca_status::Ok);
+            let (mut h, mut g) = (0u64, 1u64);
+            assert_eq!(mpca_world_hash(w, &mut h), mpca_status::Ok);
+            assert_eq!(mpca_world_hash(owned, &mut g), mpca_status::Ok);
+            assert_eq!(h, g);
+
+            let mut stats = mpca_stats { struct_size: core::mem::size_of::<mpca_stats>() as u32, ..Default::default() };
+            assert_eq!(mpca_world_stats(w, &mut stats), mpca_status::Ok);
+            assert_eq!(stats.particles, 3);
+            let (mut count, mut positions) = (0usize, [0.0f32; 9]);
+            assert_eq!(mpca_world_export_positions(w, positions.as_mut_ptr(), 2, &mut count), mpca_status::OutputTooSmall);
+            assert_eq!((count, positions), (3, [0.0; 9]));
+            assert_eq!(mpca_world_export_positions(w, positions.as_mut_ptr(), 3, &mut count), mpca_status::Ok);
+            let mut density = [0.0f32; 48];
+            assert_eq!(mpca_world_density(w, [8u32, 6, 1].as_ptr(), density.as_mut_ptr(), 48), mpca_status::Ok);
+            assert_eq!(density.iter().sum::<f32>(), 3.0);
+            let mut region = mpca_region_stats { struct_size: core::mem::size_of::<mpca_region_stats>() as u32, ..Default::default() };
+            assert_eq!(mpca_world_region_stats(w, [0u32; 3].as_ptr(), [8u32, 6, 1].as_ptr(), &mut region), mpca_status::Ok);
+            assert_eq!((region.particles, region.momentum), (3, stats.momentum));
+
+            let mut need = 0usize;
+            assert_eq!(mpca_world_save(w, null_mut(), 0, &mut need), mpca_status::Ok);
+            let mut image = std::vec![0u8; need];
+            assert_eq!(mpca_world_save(w, image.as_mut_ptr().cast(), need, &mut need), mpca_status::Ok);
+            // Saving into the world's own memory is refused before a slice
+            // over either exists.
+            assert_eq!(mpca_world_save(w, memory.as_mut_ptr().cast(), 64, &mut need), mpca_status::Overlap);
+            let mut copy_memory = std::vec![0u8; bytes];
+            let mut copy = null_mut();
+            assert_eq!(
+                mpca_world_init_from_image(image.as_ptr().cast(), image.len(), copy_memory.as_mut_ptr().cast(), bytes, &mut copy),
+                mpca_status::Ok
+            );
+            assert_eq!(mpca_world_hash(copy, &mut g), mpca_status::Ok);
+            assert_eq!(g, h);
+            image[40] ^= 1;
+            assert_eq!(mpca_world_load(copy, image.as_ptr().cast(), image.len()), mpca_status::ImageChecksum);
+
+            assert_eq!(mpca_world_deinit(copy), mpca_status::Ok);
+            assert_eq!(mpca_world_deinit(w), mpca_status::Ok);
+            assert_eq!(mpca_world_step(w, 1), mpca_status::BadHandle);
+            assert_eq!(mpca_world_destroy(owned), mpca_status::Ok);
+            assert_eq!(mpca_world_hash(owned, &mut g), mpca_status::BadHandle);
+        }
+    }
+
     /// `guard`'s promise is true only where C called: every use of it must
     /// be the body of an export. And every export but two that only look
     /// up static strings runs inside it, the panic boundary.

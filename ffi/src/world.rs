@@ -94,10 +94,9 @@ pub unsafe extern "C" fn mpca_world_create(desc: *const mpca_desc, out_world: *m
         let d = c.get(desc)?.to_core()?;
         let out = c.out(out_world)?;
         let number = handle::reserve()?;
-        let mut world = mpca_core::WorldBox::new(&d)?;
-        out.set(handle::issue(number, &mut world));
+        let world = mpca_core::WorldBox::new(&d)?;
         // Owned through the handle from now on; mpca_world_destroy frees it.
-        let _ = world.into_raw();
+        out.set(handle::issue_owned(number, world));
         Ok(())
     })
 }
