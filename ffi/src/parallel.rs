@@ -56,7 +56,7 @@ pub unsafe extern "C" fn mpca_world_step_parallel(
             }
         }
         let _release = Release(world);
-        // SAFETY: begin_step found `at` live in the registry (as world_mut
+        // SAFETY: begin_step found `at` live in the registry (as Call::world
         // does), and it now refuses every other call on this world, so this
         // is the only reference until end_step.
         let w = unsafe { World::from_ptr(at) }.map_err(|_| mpca_status::BadHandle)?;
