@@ -79,6 +79,15 @@ pub use query::{Cell, Particle, Particles, RegionStats, Stats};
 pub use snapshot::{image_description, IMAGE_VERSION};
 pub use world::{world_bytes, World, WORLD_ALIGN};
 
+/// How many cases a test runs: `full` natively, `under_miri` under Miri,
+/// which interprets every operation and runs a few thousand times slower.
+/// The same checks either way, on fewer cases; statistical bands are
+/// derived from the count, so they stay as strict.
+#[cfg(test)]
+pub(crate) const fn sized(full: usize, under_miri: usize) -> usize {
+    if cfg!(miri) { under_miri } else { full }
+}
+
 /// The README's Rust example, compiled and run as a doctest so it stays true.
 #[cfg(doctest)]
 #[doc = include_str!("../../README.md")]

@@ -12,6 +12,12 @@ use crate::{world_bytes, Description, Error, World, WORLD_ALIGN};
 
 /// A world in memory the library allocated and frees on drop.
 pub struct WorldBox {
+    /// The allocation, as the allocator returned it: the world starts
+    /// there (the allocation is aligned), and it is what `dealloc` takes.
+    /// A pointer derived from the `&mut World` covers only the world's
+    /// bytes, not the alignment slack after them, so freeing through it
+    /// would free bytes it may not reach (Miri's Stacked Borrows: UB).
+    base: NonNull<u8>,
     world: NonNull<World>,
 }
 
@@ -29,7 +35,7 @@ impl WorldBox {
         match World::init(desc, memory) {
             Ok(world) => {
                 world.head.owned = 1;
-                Ok(WorldBox { world: NonNull::from(world) })
+                Ok(WorldBox { base: ptr, world: NonNull::from(world) })
             }
             Err(e) => {
                 // SAFETY: allocated above with this layout.
@@ -39,9 +45,10 @@ impl WorldBox {
         }
     }
 
-    /// Gives up ownership; [`WorldBox::from_raw`] takes it back.
+    /// Gives up ownership; [`WorldBox::from_raw`] takes it back. The
+    /// pointer is the allocation's, valid for all of it.
     pub fn into_raw(self) -> *mut u8 {
-        let p = self.world.as_ptr().cast::<u8>();
+        let p = self.base.as_ptr();
         core::mem::forget(self);
         p
     }
@@ -50,14 +57,17 @@ impl WorldBox {
     /// no live world, or one the library did not allocate, is refused.
     ///
     /// # Safety
-    /// As [`World::from_ptr`]; the world must not be in use elsewhere.
+    /// As [`World::from_ptr`]; the world must not be in use elsewhere, and
+    /// if it is owned, `ptr` must be the pointer [`WorldBox::into_raw`]
+    /// returned (or one derived from it), valid for the whole allocation.
     pub unsafe fn from_raw(ptr: *mut u8) -> Result<WorldBox, Error> {
         // SAFETY: forwarded to the caller.
         let world = unsafe { World::from_ptr(ptr)? };
         if !world.is_owned() {
             return Err(Error::NotOwned);
         }
-        Ok(WorldBox { world: NonNull::from(world) })
+        let base = NonNull::new(ptr).ok_or(Error::NotAWorld)?;
+        Ok(WorldBox { base, world: NonNull::from(world) })
     }
 }
 
@@ -82,9 +92,9 @@ impl Drop for WorldBox {
         let size = world_bytes(world.description()).unwrap_or(0);
         world.retire();
         if let Ok(layout) = Layout::from_size_align(size, WORLD_ALIGN) {
-            // SAFETY: allocated in `new` with exactly this layout: the
-            // description, hence world_bytes, never changes.
-            unsafe { dealloc(self.world.as_ptr().cast::<u8>(), layout) };
+            // SAFETY: `base` was allocated in `new` with exactly this
+            // layout (the description, hence world_bytes, never changes).
+            unsafe { dealloc(self.base.as_ptr(), layout) };
         }
     }
 }

@@ -209,23 +209,25 @@ mod tests {
 
     #[test]
     fn below_is_uniform() {
-        // 60,000 draws in 6 bins and in 7 bins: each count is binomial; a
-        // 5 sd band fails by chance with probability ~6e-7 per bin.
+        // 60,000 draws (2,000 under Miri) in 6 bins and in 7 bins: each
+        // count is binomial; a 5 sd band fails by chance with probability
+        // ~6e-7 per bin.
+        let draws = crate::sized(60_000, 2_000) as u32;
         for n in [6u32, 7, 100_003] {
             let bins = n.min(7) as usize;
             let mut rng = block_stream(7, 0, u64::from(n));
             let mut counts = [0u32; 7];
-            for _ in 0..60_000 {
+            for _ in 0..draws {
                 let v = rng.below(n);
                 assert!(v < n);
                 counts[(u64::from(v) * bins as u64 / u64::from(n)) as usize] += 1;
             }
             let p = 1.0 / bins as f64;
-            let sd = (60_000.0 * p * (1.0 - p)).sqrt();
+            let sd = (f64::from(draws) * p * (1.0 - p)).sqrt();
             for &c in &counts[..bins] {
                 // For n = 100,003 the 7 bins differ in size by one value in
                 // 14,286: far inside the band.
-                assert!((f64::from(c) - 60_000.0 * p).abs() < 5.0 * sd, "{n}: {counts:?}");
+                assert!((f64::from(c) - f64::from(draws) * p).abs() < 5.0 * sd, "{n}: {counts:?}");
             }
         }
     }
@@ -233,7 +235,7 @@ mod tests {
     #[test]
     fn unit_stays_below_one() {
         let mut rng = block_stream(0, 0, 0);
-        for _ in 0..100_000 {
+        for _ in 0..crate::sized(100_000, 2_000) {
             let u = rng.unit();
             assert!((0.0..1.0).contains(&u));
         }

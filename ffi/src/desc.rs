@@ -2,7 +2,7 @@
 
 use mpca_core::{Boundary, Collisions, Description, Drag, Drift, Forces, Method, Quantization, Vortex};
 
-use crate::{check_size, flag, guard, mpca_status, read, write};
+use crate::{check_size, flag, guard, mpca_status};
 
 /// What happens at one face of the domain (M4). Values of `mpca_desc.boundary`.
 #[repr(u32)]
@@ -267,12 +267,12 @@ impl mpca_desc {
 /// checked later, by mpca_world_bytes and mpca_world_init.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_desc_defaults(out: *mut mpca_desc, dim: u32, nx: u32, ny: u32, nz: u32) -> mpca_status {
-    guard(|| {
-        let out = unsafe { write(out)? };
+    guard(|c| {
+        let out = c.out(out)?;
         let d = if dim == 3 { Description::new_3d(nx, ny, nz) } else { Description::new_2d(nx, ny) };
-        let mut c = mpca_desc::from_core(&d);
-        c.dim = dim;
-        *out = c;
+        let mut desc = mpca_desc::from_core(&d);
+        desc.dim = dim;
+        out.set(desc);
         Ok(())
     })
 }
@@ -280,17 +280,17 @@ pub unsafe extern "C" fn mpca_desc_defaults(out: *mut mpca_desc, dim: u32, nx: u
 /// Checks a description in full without building anything.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_desc_validate(desc: *const mpca_desc) -> mpca_status {
-    guard(|| Ok(unsafe { read(desc)? }.to_core()?.validate()?))
+    guard(|c| Ok(c.get(desc)?.to_core()?.validate()?))
 }
 
 /// Bytes of memory a world built from `desc` needs with mpca_world_init,
 /// alignment slack included (any alignment of the memory is accepted).
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_world_bytes(desc: *const mpca_desc, out_bytes: *mut usize) -> mpca_status {
-    guard(|| {
-        let d = unsafe { read(desc)? }.to_core()?;
-        let out = unsafe { write(out_bytes)? };
-        *out = mpca_core::world_bytes(&d)?;
+    guard(|c| {
+        let d = c.get(desc)?.to_core()?;
+        let out = c.out(out_bytes)?;
+        out.set(mpca_core::world_bytes(&d)?);
         Ok(())
     })
 }

@@ -2,8 +2,7 @@
 
 use mpca_core::Emitter;
 
-use crate::world::world_mut;
-use crate::{check_size, guard, mpca_status, mpca_world, read, write};
+use crate::{check_size, guard, mpca_status, mpca_world};
 
 /// An emitter. Set `struct_size` to `sizeof(mpca_emitter)`.
 #[repr(C)]
@@ -33,10 +32,10 @@ pub struct mpca_emitter {
 /// Adds an emitter; its index goes to `out_index`.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_world_add_emitter(world: *mut mpca_world, emitter: *const mpca_emitter, out_index: *mut u32) -> mpca_status {
-    guard(|| {
-        let w = unsafe { world_mut(world)? };
-        let e = unsafe { read(emitter)? };
-        let out = unsafe { write(out_index)? };
+    guard(|c| {
+        let w = c.world(world)?;
+        let e = c.get(emitter)?;
+        let out = c.out(out_index)?;
         check_size::<mpca_emitter>(e.struct_size)?;
         let index = w.add_emitter(Emitter {
             min: e.min,
@@ -47,7 +46,7 @@ pub unsafe extern "C" fn mpca_world_add_emitter(world: *mut mpca_world, emitter:
             mass: e.mass,
             lifetime: e.lifetime,
         })?;
-        *out = index as u32;
+        out.set(index as u32);
         Ok(())
     })
 }
@@ -55,8 +54,8 @@ pub unsafe extern "C" fn mpca_world_add_emitter(world: *mut mpca_world, emitter:
 /// Changes the rate of emitter `index`.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_world_set_emitter_rate(world: *mut mpca_world, index: u32, rate: f32) -> mpca_status {
-    guard(|| {
-        let w = unsafe { world_mut(world)? };
+    guard(|c| {
+        let w = c.world(world)?;
         Ok(w.set_emitter_rate(index as usize, rate)?)
     })
 }

@@ -4,15 +4,14 @@
 
 use mpca_core::Vortex;
 
-use crate::world::world_mut;
-use crate::{array, guard, mpca_status, mpca_world, slice};
+use crate::{guard, mpca_status, mpca_world};
 
 /// Sets the uniform acceleration (3 values).
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_world_set_gravity(world: *mut mpca_world, g: *const f32) -> mpca_status {
-    guard(|| {
-        let w = unsafe { world_mut(world)? };
-        Ok(w.set_gravity(unsafe { array(g)? })?)
+    guard(|c| {
+        let w = c.world(world)?;
+        Ok(w.set_gravity(c.array(g)?)?)
     })
 }
 
@@ -20,18 +19,18 @@ pub unsafe extern "C" fn mpca_world_set_gravity(world: *mut mpca_world, g: *cons
 /// must be `dim` times the cell count.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_world_set_force_field(world: *mut mpca_world, forces: *const f32, len: usize) -> mpca_status {
-    guard(|| {
-        let w = unsafe { world_mut(world)? };
-        Ok(w.set_force_field(unsafe { slice(forces, len, mpca_status::BadLength)? })?)
+    guard(|c| {
+        let w = c.world(world)?;
+        Ok(w.set_force_field(c.slice(forces, len, mpca_status::BadLength)?)?)
     })
 }
 
 /// Sets the force (3 values) on the cell at `pos`.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_world_set_cell_force(world: *mut mpca_world, pos: *const u32, force: *const f32) -> mpca_status {
-    guard(|| {
-        let w = unsafe { world_mut(world)? };
-        let (pos, f) = unsafe { (array(pos)?, array(force)?) };
+    guard(|c| {
+        let w = c.world(world)?;
+        let (pos, f) = (c.array(pos)?, c.array(force)?);
         Ok(w.set_cell_force(pos, f)?)
     })
 }
@@ -39,18 +38,18 @@ pub unsafe extern "C" fn mpca_world_set_cell_force(world: *mut mpca_world, pos: 
 /// Replaces the potential: one float per cell, x fastest.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_world_set_potential(world: *mut mpca_world, u: *const f32, len: usize) -> mpca_status {
-    guard(|| {
-        let w = unsafe { world_mut(world)? };
-        Ok(w.set_potential(unsafe { slice(u, len, mpca_status::BadLength)? })?)
+    guard(|c| {
+        let w = c.world(world)?;
+        Ok(w.set_potential(c.slice(u, len, mpca_status::BadLength)?)?)
     })
 }
 
 /// Sets the potential of the cell at `pos`.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_world_set_cell_potential(world: *mut mpca_world, pos: *const u32, u: f32) -> mpca_status {
-    guard(|| {
-        let w = unsafe { world_mut(world)? };
-        Ok(w.set_cell_potential(unsafe { array(pos)? }, u)?)
+    guard(|c| {
+        let w = c.world(world)?;
+        Ok(w.set_cell_potential(c.array(pos)?, u)?)
     })
 }
 
@@ -59,8 +58,8 @@ pub unsafe extern "C" fn mpca_world_set_cell_potential(world: *mut mpca_world, p
 /// centre, however small the core.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_world_set_vortex(world: *mut mpca_world, cx: f32, cy: f32, core_radius: f32, circulation: f32) -> mpca_status {
-    guard(|| {
-        let w = unsafe { world_mut(world)? };
+    guard(|c| {
+        let w = c.world(world)?;
         Ok(w.set_vortex(Vortex { centre: [cx, cy], core_radius, circulation })?)
     })
 }

@@ -16,7 +16,7 @@ use mpca_core::World;
 use crate::{mpca_status, mpca_world};
 
 #[cfg(feature = "std")]
-pub(crate) use hosted::{begin_step, close_tasks, end_step, issue, open_tasks, reserve, resolve, revoke, run_task};
+pub(crate) use hosted::{begin_step, close_tasks, end_step, issue, issue_owned, open_tasks, reserve, resolve, revoke, run_task};
 
 #[cfg(not(feature = "std"))]
 pub(crate) use firmware::{issue, reserve, resolve, revoke};
@@ -121,6 +121,20 @@ mod hosted {
     /// refused from now on.
     pub(crate) fn issue(number: Reserved, world: &mut World) -> *mut mpca_world {
         let entry = Entry { at: NonNull::from(&mut *world).cast(), bytes: world.size_in_bytes(), owned: world.is_owned(), step: Step::Idle };
+        register(number, entry)
+    }
+
+    /// Registers a world the library allocated, by the pointer
+    /// `WorldBox::into_raw` gives: the allocation's own, which
+    /// mpca_world_destroy frees through (one derived from the `&mut World`
+    /// would not reach the allocation's alignment slack).
+    pub(crate) fn issue_owned(number: Reserved, world: mpca_core::WorldBox) -> *mut mpca_world {
+        let bytes = world.size_in_bytes();
+        let at = NonNull::new(world.into_raw()).expect("an allocation is not NULL");
+        register(number, Entry { at, bytes, owned: true, step: Step::Idle })
+    }
+
+    fn register(number: Reserved, entry: Entry) -> *mut mpca_world {
         let handle = value(number.0);
         let mut r = registry();
         if !entry.owned {
@@ -249,11 +263,13 @@ mod hosted {
 
         #[test]
         fn handle_values_of_distinct_numbers_differ_and_are_not_null() {
-            let values: std::collections::BTreeSet<usize> = (1..=100_000).map(value).collect();
-            assert_eq!(values.len(), 100_000);
+            // Under Miri, which runs some thousand times slower, fewer.
+            let (numbers, probed) = if cfg!(miri) { (500, 4) } else { (100_000, 1000) };
+            let values: std::collections::BTreeSet<usize> = (1..=numbers).map(value).collect();
+            assert_eq!(values.len(), numbers);
             assert!(!values.contains(&0));
             // No handle is another plus a small offset.
-            for v in (1..=1000).map(value) {
+            for v in (1..=probed).map(value) {
                 for d in 1..=256 {
                     assert!(!values.contains(&v.wrapping_add(d)) && !values.contains(&v.wrapping_sub(d)));
                 }

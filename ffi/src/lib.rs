@@ -30,6 +30,7 @@
 #[cfg(feature = "std")]
 extern crate std;
 
+mod call;
 mod desc;
 mod emitters;
 mod forces;
@@ -42,6 +43,7 @@ mod snapshot;
 mod status;
 mod world;
 
+pub(crate) use call::{fits, guard, Call};
 pub use desc::*;
 pub use emitters::*;
 pub use forces::*;
@@ -82,83 +84,6 @@ const _: () = {
     assert!(size_of::<mpca_status>() == 4 && size_of::<mpca_boundary>() == 4);
 };
 
-/// Runs an export's body inside the panic boundary and turns its result into
-/// a status.
-#[inline]
-pub(crate) fn guard(body: impl FnOnce() -> Result<(), mpca_status>) -> mpca_status {
-    #[cfg(feature = "std")]
-    let result = match std::panic::catch_unwind(core::panic::AssertUnwindSafe(body)) {
-        Ok(r) => r,
-        Err(_) => Err(mpca_status::Panic),
-    };
-    #[cfg(not(feature = "std"))]
-    let result = body();
-    match result {
-        Ok(()) => mpca_status::Ok,
-        Err(s) => s,
-    }
-}
-
-/// `&*p`, or `NullPointer`.
-#[inline]
-pub(crate) unsafe fn read<'a, T>(p: *const T) -> Result<&'a T, mpca_status> {
-    // SAFETY: the caller's pointer is valid if not NULL (the C contract).
-    unsafe { p.as_ref() }.ok_or(mpca_status::NullPointer)
-}
-
-/// `&mut *p`, or `NullPointer`.
-#[inline]
-pub(crate) unsafe fn write<'a, T>(p: *mut T) -> Result<&'a mut T, mpca_status> {
-    // SAFETY: as in `read`.
-    unsafe { p.as_mut() }.ok_or(mpca_status::NullPointer)
-}
-
-/// `n` values at `p` (3 for positions and vectors), or `NullPointer`.
-#[inline]
-pub(crate) unsafe fn array<T: Copy, const N: usize>(p: *const T) -> Result<[T; N], mpca_status> {
-    if p.is_null() {
-        return Err(mpca_status::NullPointer);
-    }
-    // SAFETY: the C contract: `p` points at N readable values.
-    Ok(core::array::from_fn(|i| unsafe { p.add(i).read() }))
-}
-
-/// Whether `len` values of `T` fit in one object: at most `isize::MAX`
-/// bytes, the bound `core::slice::from_raw_parts` requires.
-#[inline]
-pub(crate) fn fits<T>(len: usize) -> bool {
-    len <= isize::MAX as usize / core::mem::size_of::<T>().max(1)
-}
-
-/// A slice of `len` values at `p`; NULL is refused even when `len` is 0, and
-/// a length no object can have with `too_long`, before any slice is formed.
-#[inline]
-pub(crate) unsafe fn slice<'a, T>(p: *const T, len: usize, too_long: mpca_status) -> Result<&'a [T], mpca_status> {
-    if p.is_null() {
-        return Err(mpca_status::NullPointer);
-    }
-    if !fits::<T>(len) {
-        return Err(too_long);
-    }
-    // SAFETY: not NULL, and `len` values span at most isize::MAX bytes;
-    // the C contract: `p` points at `len` readable values.
-    Ok(unsafe { core::slice::from_raw_parts(p, len) })
-}
-
-/// A mutable slice of `len` values at `p`; NULL and lengths no object can
-/// have are refused, as in [`slice`].
-#[inline]
-pub(crate) unsafe fn slice_mut<'a, T>(p: *mut T, len: usize, too_long: mpca_status) -> Result<&'a mut [T], mpca_status> {
-    if p.is_null() {
-        return Err(mpca_status::NullPointer);
-    }
-    if !fits::<T>(len) {
-        return Err(too_long);
-    }
-    // SAFETY: as in `slice`, for `len` writable values.
-    Ok(unsafe { core::slice::from_raw_parts_mut(p, len) })
-}
-
 /// 0 or 1 as a bool; anything else is `BadEnum`.
 #[inline]
 pub(crate) fn flag(v: u32) -> Result<bool, mpca_status> {
@@ -190,5 +115,5 @@ fn on_panic(_: &core::panic::PanicInfo<'_>) -> ! {
 #[cfg(feature = "panic-test")]
 #[unsafe(no_mangle)]
 pub extern "C" fn mpca_debug_panic() -> mpca_status {
-    guard(|| panic!("mpca_debug_panic was called"))
+    guard(|_| panic!("mpca_debug_panic was called"))
 }

@@ -3,16 +3,15 @@
 
 use mpca_core::Shape;
 
-use crate::world::{world_mut, world_ref};
-use crate::{array, guard, mpca_status, mpca_world, slice, write};
+use crate::{guard, mpca_status, mpca_world};
 
 /// Makes the cell at `pos` an obstacle with outward `normal` (3 values,
 /// normalised by the library) and restitution `e`.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_world_add_obstacle(world: *mut mpca_world, pos: *const u32, normal: *const f32, e: f32) -> mpca_status {
-    guard(|| {
-        let w = unsafe { world_mut(world)? };
-        let (pos, n) = unsafe { (array(pos)?, array(normal)?) };
+    guard(|c| {
+        let w = c.world(world)?;
+        let (pos, n) = (c.array(pos)?, c.array(normal)?);
         Ok(w.add_obstacle(pos, n, e)?)
     })
 }
@@ -23,9 +22,9 @@ pub unsafe extern "C" fn mpca_world_add_obstacle(world: *mut mpca_world, pos: *c
 /// a normal with neither is refused (`MPCA_STATUS_BAD_SHAPE`).
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_world_add_half_space(world: *mut mpca_world, point: *const f32, normal: *const f32, e: f32) -> mpca_status {
-    guard(|| {
-        let w = unsafe { world_mut(world)? };
-        let (point, normal) = unsafe { (array(point)?, array(normal)?) };
+    guard(|c| {
+        let w = c.world(world)?;
+        let (point, normal) = (c.array(point)?, c.array(normal)?);
         Ok(w.add_shape(Shape::HalfSpace { point, normal }, e)?)
     })
 }
@@ -34,9 +33,9 @@ pub unsafe extern "C" fn mpca_world_add_half_space(world: *mut mpca_world, point
 /// cell units: cell i has its centre at i + 0.5).
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_world_add_box(world: *mut mpca_world, min: *const f32, max: *const f32, e: f32) -> mpca_status {
-    guard(|| {
-        let w = unsafe { world_mut(world)? };
-        let (min, max) = unsafe { (array(min)?, array(max)?) };
+    guard(|c| {
+        let w = c.world(world)?;
+        let (min, max) = (c.array(min)?, c.array(max)?);
         Ok(w.add_shape(Shape::Box { min, max }, e)?)
     })
 }
@@ -44,8 +43,8 @@ pub unsafe extern "C" fn mpca_world_add_box(world: *mut mpca_world, min: *const 
 /// A disc of centre (`cx`, `cy`) and radius `radius` (2D worlds only).
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_world_add_disc(world: *mut mpca_world, cx: f32, cy: f32, radius: f32, e: f32) -> mpca_status {
-    guard(|| {
-        let w = unsafe { world_mut(world)? };
+    guard(|c| {
+        let w = c.world(world)?;
         Ok(w.add_shape(Shape::Disc { centre: [cx, cy], radius }, e)?)
     })
 }
@@ -53,9 +52,9 @@ pub unsafe extern "C" fn mpca_world_add_disc(world: *mut mpca_world, cx: f32, cy
 /// A sphere of centre `centre` (3 values) and radius `radius` (3D only).
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_world_add_sphere(world: *mut mpca_world, centre: *const f32, radius: f32, e: f32) -> mpca_status {
-    guard(|| {
-        let w = unsafe { world_mut(world)? };
-        let centre = unsafe { array(centre)? };
+    guard(|c| {
+        let w = c.world(world)?;
+        let centre = c.array(centre)?;
         Ok(w.add_shape(Shape::Sphere { centre, radius }, e)?)
     })
 }
@@ -66,9 +65,9 @@ pub unsafe extern "C" fn mpca_world_add_sphere(world: *mut mpca_world, centre: *
 /// (`MPCA_STATUS_UNDEFINED_NORMAL`).
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_world_add_obstacle_mask(world: *mut mpca_world, mask: *const u8, len: usize, e: f32) -> mpca_status {
-    guard(|| {
-        let w = unsafe { world_mut(world)? };
-        let mask = unsafe { slice(mask, len, mpca_status::BadLength)? };
+    guard(|c| {
+        let w = c.world(world)?;
+        let mask = c.slice(mask, len, mpca_status::BadLength)?;
         Ok(w.add_obstacle_mask(mask, e)?)
     })
 }
@@ -83,18 +82,16 @@ pub unsafe extern "C" fn mpca_world_surface(
     out_normal: *mut f32,
     out_restitution: *mut f32,
 ) -> mpca_status {
-    guard(|| {
-        let w = unsafe { world_ref(world)? };
-        let pos = unsafe { array::<u32, 3>(pos)? };
-        let e = unsafe { write(out_restitution)? };
-        if out_normal.is_null() {
-            return Err(mpca_status::NullPointer);
-        }
+    guard(|c| {
+        let w = c.world_ref(world)?;
+        let pos = c.array::<u32, 3>(pos)?;
+        let e = c.out(out_restitution)?;
+        // 3 floats: an array of them, aligned as a float.
+        let normal = c.out(out_normal.cast::<[f32; 3]>())?;
         w.cell(pos)?;
         let s = w.surface(pos).ok_or(mpca_status::NotASurface)?;
-        // SAFETY: the C contract: out_normal has room for 3 floats.
-        unsafe { core::ptr::copy_nonoverlapping(s.normal.as_ptr(), out_normal, 3) };
-        *e = s.restitution;
+        normal.set(s.normal);
+        e.set(s.restitution);
         Ok(())
     })
 }

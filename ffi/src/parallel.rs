@@ -42,7 +42,7 @@ pub unsafe extern "C" fn mpca_world_step_parallel(
     run_tasks: mpca_run_tasks,
     user_data: *mut c_void,
 ) -> mpca_status {
-    guard(|| {
+    guard(|_| {
         if world.is_null() {
             return Err(mpca_status::NullPointer);
         }
@@ -56,7 +56,7 @@ pub unsafe extern "C" fn mpca_world_step_parallel(
             }
         }
         let _release = Release(world);
-        // SAFETY: begin_step found `at` live in the registry (as world_mut
+        // SAFETY: begin_step found `at` live in the registry (as Call::world
         // does), and it now refuses every other call on this world, so this
         // is the only reference until end_step.
         let w = unsafe { World::from_ptr(at) }.map_err(|_| mpca_status::BadHandle)?;
@@ -88,7 +88,7 @@ pub unsafe extern "C" fn mpca_world_step_parallel(
 /// step is in flight (`MPCA_STATUS_STALE_TASK`). Hosted builds only.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_world_step_task(world: *mut mpca_world, ticket: u64, index: u32) -> mpca_status {
-    guard(|| {
+    guard(|_| {
         if world.is_null() {
             return Err(mpca_status::NullPointer);
         }

@@ -3,8 +3,7 @@
 
 use mpca_core::{Cell, Particle};
 
-use crate::world::{world_mut, world_ref};
-use crate::{array, guard, mpca_status, mpca_world, slice_mut, write};
+use crate::{guard, mpca_status, mpca_world, Call};
 
 /// One particle.
 #[repr(C)]
@@ -55,9 +54,9 @@ fn particle_to_c(p: Particle) -> mpca_particle {
 /// rebuilt from its own export; anything else is `MPCA_STATUS_SPEED_RANGE`.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_world_add_particle(world: *mut mpca_world, pos: *const u32, velocity: *const f32) -> mpca_status {
-    guard(|| {
-        let w = unsafe { world_mut(world)? };
-        let (pos, v) = unsafe { (array(pos)?, array(velocity)?) };
+    guard(|c| {
+        let w = c.world(world)?;
+        let (pos, v) = (c.array(pos)?, c.array(velocity)?);
         Ok(w.add_particle(pos, v)?)
     })
 }
@@ -71,9 +70,9 @@ pub unsafe extern "C" fn mpca_world_add_particle_mass(
     velocity: *const f32,
     mass: f32,
 ) -> mpca_status {
-    guard(|| {
-        let w = unsafe { world_mut(world)? };
-        let (pos, v) = unsafe { (array(pos)?, array(velocity)?) };
+    guard(|c| {
+        let w = c.world(world)?;
+        let (pos, v) = (c.array(pos)?, c.array(velocity)?);
         Ok(w.add_particle_with_mass(pos, v, mass)?)
     })
 }
@@ -82,11 +81,11 @@ pub unsafe extern "C" fn mpca_world_add_particle_mass(
 /// NULL).
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_world_remove_particle(world: *mut mpca_world, pos: *const u32, out: *mut mpca_particle) -> mpca_status {
-    guard(|| {
-        let w = unsafe { world_mut(world)? };
-        let pos = unsafe { array(pos)? };
-        let out = unsafe { write(out)? };
-        *out = particle_to_c(w.remove_particle(pos)?);
+    guard(|c| {
+        let w = c.world(world)?;
+        let pos = c.array(pos)?;
+        let out = c.out(out)?;
+        out.set(particle_to_c(w.remove_particle(pos)?));
         Ok(())
     })
 }
@@ -94,15 +93,15 @@ pub unsafe extern "C" fn mpca_world_remove_particle(world: *mut mpca_world, pos:
 /// What the cell at `pos` holds.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_world_cell(world: *const mpca_world, pos: *const u32, out: *mut mpca_cell) -> mpca_status {
-    guard(|| {
-        let w = unsafe { world_ref(world)? };
-        let pos = unsafe { array(pos)? };
-        let out = unsafe { write(out)? };
-        *out = match w.cell(pos)? {
+    guard(|c| {
+        let w = c.world_ref(world)?;
+        let pos = c.array(pos)?;
+        let out = c.out(out)?;
+        out.set(match w.cell(pos)? {
             Cell::Empty => mpca_cell { kind: mpca_cell_kind::Empty as u32, ..Default::default() },
             Cell::Obstacle => mpca_cell { kind: mpca_cell_kind::Obstacle as u32, ..Default::default() },
             Cell::Particle(p) => mpca_cell { kind: mpca_cell_kind::Particle as u32, particle: particle_to_c(p) },
-        };
+        });
         Ok(())
     })
 }
@@ -110,9 +109,9 @@ pub unsafe extern "C" fn mpca_world_cell(world: *const mpca_world, pos: *const u
 /// The number of particles now.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_world_particle_count(world: *const mpca_world, out_count: *mut usize) -> mpca_status {
-    guard(|| {
-        let w = unsafe { world_ref(world)? };
-        *unsafe { write(out_count)? } = w.particle_count() as usize;
+    guard(|c| {
+        let w = c.world_ref(world)?;
+        c.out(out_count)?.set(w.particle_count() as usize);
         Ok(())
     })
 }
@@ -122,35 +121,35 @@ pub unsafe extern "C" fn mpca_world_particle_count(world: *const mpca_world, out
 /// `out_count`. Too small a buffer writes nothing but the count. `out`
 /// NULL with `capacity` 0 asks for the count alone (the size query every
 /// export of the header answers); NULL with room claimed is refused.
-unsafe fn export(
+/// The body of the three exports below, inside their `guard`.
+fn export(
+    c: &Call<'_>,
     world: *const mpca_world,
     out: *mut f32,
     capacity: usize,
     out_count: *mut usize,
     per: usize,
     put: impl Fn(&Particle, &mut [f32]),
-) -> mpca_status {
-    guard(|| {
-        let w = unsafe { world_ref(world)? };
-        let count = unsafe { write(out_count)? };
-        if out.is_null() && capacity != 0 {
-            return Err(mpca_status::NullPointer);
-        }
-        let n = w.particle_count() as usize;
-        *count = n;
-        if out.is_null() {
-            return Ok(()); // the size query
-        }
-        if capacity < n {
-            return Err(mpca_status::OutputTooSmall);
-        }
-        let floats = n.checked_mul(per).ok_or(mpca_status::OutputTooSmall)?;
-        let dst = unsafe { slice_mut(out, floats, mpca_status::OutputTooSmall)? };
-        for (p, chunk) in w.particles().zip(dst.chunks_exact_mut(per)) {
-            put(&p, chunk);
-        }
-        Ok(())
-    })
+) -> Result<(), mpca_status> {
+    let w = c.world_ref(world)?;
+    let count = c.out(out_count)?;
+    if out.is_null() && capacity != 0 {
+        return Err(mpca_status::NullPointer);
+    }
+    let n = w.particle_count() as usize;
+    count.set(n);
+    if out.is_null() {
+        return Ok(()); // the size query
+    }
+    if capacity < n {
+        return Err(mpca_status::OutputTooSmall);
+    }
+    let floats = n.checked_mul(per).ok_or(mpca_status::OutputTooSmall)?;
+    let dst = c.slice_mut(out, floats, mpca_status::OutputTooSmall)?;
+    for (p, chunk) in w.particles().zip(dst.chunks_exact_mut(per)) {
+        put(&p, chunk);
+    }
+    Ok(())
 }
 
 /// Particle positions as 3 floats each (cell centres: x + 0.5, y + 0.5,
@@ -171,7 +170,7 @@ pub unsafe extern "C" fn mpca_world_export_positions(
     capacity: usize,
     out_count: *mut usize,
 ) -> mpca_status {
-    unsafe { export(world, out, capacity, out_count, 3, |p, o| o.copy_from_slice(&p.pos.map(|c| c as f32 + 0.5))) }
+    guard(|c| export(c, world, out, capacity, out_count, 3, |p, o| o.copy_from_slice(&p.pos.map(|x| x as f32 + 0.5))))
 }
 
 /// Particle velocities as 3 floats each, in the order of
@@ -183,7 +182,7 @@ pub unsafe extern "C" fn mpca_world_export_velocities(
     capacity: usize,
     out_count: *mut usize,
 ) -> mpca_status {
-    unsafe { export(world, out, capacity, out_count, 3, |p, o| o.copy_from_slice(&p.velocity)) }
+    guard(|c| export(c, world, out, capacity, out_count, 3, |p, o| o.copy_from_slice(&p.velocity)))
 }
 
 /// Particle masses, one float each, in the order of
@@ -195,7 +194,7 @@ pub unsafe extern "C" fn mpca_world_export_masses(
     capacity: usize,
     out_count: *mut usize,
 ) -> mpca_status {
-    unsafe { export(world, out, capacity, out_count, 1, |p, o| o[0] = p.mass) }
+    guard(|c| export(c, world, out, capacity, out_count, 1, |p, o| o[0] = p.mass))
 }
 
 /// The share of occupied cells in each of `res` (3 values; the third 1 in
@@ -203,10 +202,10 @@ pub unsafe extern "C" fn mpca_world_export_masses(
 /// `res`). With `res` equal to the world size this is the occupancy.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_world_density(world: *const mpca_world, res: *const u32, out: *mut f32, len: usize) -> mpca_status {
-    guard(|| {
-        let w = unsafe { world_ref(world)? };
-        let res = unsafe { array(res)? };
-        let out = unsafe { slice_mut(out, len, mpca_status::BadResolution)? };
+    guard(|c| {
+        let w = c.world_ref(world)?;
+        let res = c.array(res)?;
+        let out = c.slice_mut(out, len, mpca_status::BadResolution)?;
         Ok(w.density(res, out)?)
     })
 }
@@ -214,10 +213,10 @@ pub unsafe extern "C" fn mpca_world_density(world: *const mpca_world, res: *cons
 /// As mpca_world_density, scaled to 0..255 bytes for a texture upload.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_world_density_u8(world: *const mpca_world, res: *const u32, out: *mut u8, len: usize) -> mpca_status {
-    guard(|| {
-        let w = unsafe { world_ref(world)? };
-        let res = unsafe { array(res)? };
-        let out = unsafe { slice_mut(out, len, mpca_status::BadResolution)? };
+    guard(|c| {
+        let w = c.world_ref(world)?;
+        let res = c.array(res)?;
+        let out = c.slice_mut(out, len, mpca_status::BadResolution)?;
         Ok(w.density_u8(res, out)?)
     })
 }

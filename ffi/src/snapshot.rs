@@ -6,12 +6,11 @@ use core::ffi::c_void;
 
 use mpca_core::{Error, World};
 
-use crate::world::{world_mut, world_ref};
-use crate::{fits, guard, handle, mpca_desc, mpca_status, mpca_world, slice, slice_mut, write};
+use crate::{fits, guard, handle, mpca_desc, mpca_status, mpca_world};
 
 /// Whether `a_len` bytes at `a` and `b_len` bytes at `b` share a byte;
 /// found from the addresses alone, before any slice is formed over either.
-/// NULL and lengths no object can have are left to `slice` to refuse.
+/// NULL and lengths no object can have are left to `Call::slice` to refuse.
 fn overlap(a: *const u8, a_len: usize, b: *const u8, b_len: usize) -> bool {
     if a.is_null() || b.is_null() || !fits::<u8>(a_len) || !fits::<u8>(b_len) {
         return false;
@@ -30,9 +29,9 @@ fn span(w: &World) -> (*const u8, usize) {
 /// go, never beyond the size of the world's memory plus 252 bytes.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_world_snapshot_bytes(world: *const mpca_world, out_bytes: *mut usize) -> mpca_status {
-    guard(|| {
-        let w = unsafe { world_ref(world)? };
-        *unsafe { write(out_bytes)? } = w.snapshot_bytes();
+    guard(|c| {
+        let w = c.world_ref(world)?;
+        c.out(out_bytes)?.set(w.snapshot_bytes());
         Ok(())
     })
 }
@@ -45,26 +44,26 @@ pub unsafe extern "C" fn mpca_world_snapshot_bytes(world: *const mpca_world, out
 /// overlap the world's memory (`MPCA_STATUS_OVERLAP`).
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_world_save(world: *const mpca_world, buf: *mut c_void, len: usize, out_written: *mut usize) -> mpca_status {
-    guard(|| {
-        let w = unsafe { world_ref(world)? };
-        let written = unsafe { write(out_written)? };
+    guard(|c| {
+        let w = c.world_ref(world)?;
+        let written = c.out(out_written)?;
         let need = w.snapshot_bytes();
         if buf.is_null() && len == 0 {
-            *written = need;
+            written.set(need);
             return Ok(());
         }
         let (at, size) = span(w);
         if overlap(buf.cast(), len, at, size) {
             return Err(mpca_status::Overlap);
         }
-        let out = unsafe { slice_mut(buf.cast::<u8>(), len, mpca_status::BadLength)? };
+        let out = c.slice_mut(buf.cast::<u8>(), len, mpca_status::BadLength)?;
         match w.save(out) {
             Ok(n) => {
-                *written = n;
+                written.set(n);
                 Ok(())
             }
             Err(Error::OutputTooSmall) => {
-                *written = need;
+                written.set(need);
                 Err(mpca_status::OutputTooSmall)
             }
             Err(e) => Err(e.into()),
@@ -90,13 +89,13 @@ pub unsafe extern "C" fn mpca_world_save(world: *const mpca_world, buf: *mut c_v
 /// not overlap the world's memory (`MPCA_STATUS_OVERLAP`).
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_world_load(world: *mut mpca_world, image: *const c_void, len: usize) -> mpca_status {
-    guard(|| {
-        let w = unsafe { world_mut(world)? };
+    guard(|c| {
+        let w = c.world(world)?;
         let (at, size) = span(w);
         if overlap(image.cast(), len, at, size) {
             return Err(mpca_status::Overlap);
         }
-        let image = unsafe { slice(image.cast::<u8>(), len, mpca_status::BadLength)? };
+        let image = c.slice(image.cast::<u8>(), len, mpca_status::BadLength)?;
         Ok(w.load(image)?)
     })
 }
@@ -108,10 +107,10 @@ pub unsafe extern "C" fn mpca_world_load(world: *mut mpca_world, image: *const c
 /// mpca_world_load accepts the image into.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_desc_from_image(image: *const c_void, len: usize, out: *mut mpca_desc) -> mpca_status {
-    guard(|| {
-        let image = unsafe { slice(image.cast::<u8>(), len, mpca_status::BadLength)? };
-        let out = unsafe { write(out)? };
-        *out = mpca_desc::from_core(&mpca_core::image_description(image)?);
+    guard(|c| {
+        let image = c.slice(image.cast::<u8>(), len, mpca_status::BadLength)?;
+        let out = c.out(out)?;
+        out.set(mpca_desc::from_core(&mpca_core::image_description(image)?));
         Ok(())
     })
 }
@@ -131,16 +130,16 @@ pub unsafe extern "C" fn mpca_world_init_from_image(
     len: usize,
     out_world: *mut *mut mpca_world,
 ) -> mpca_status {
-    guard(|| {
-        let out = unsafe { write(out_world)? };
+    guard(|c| {
+        let out = c.out(out_world)?;
         if overlap(image.cast(), image_len, memory.cast(), len) {
             return Err(mpca_status::Overlap);
         }
-        let image = unsafe { slice(image.cast::<u8>(), image_len, mpca_status::BadLength)? };
-        let bytes = unsafe { slice_mut(memory.cast::<u8>(), len, mpca_status::BadLength)? };
+        let image = c.slice(image.cast::<u8>(), image_len, mpca_status::BadLength)?;
+        let bytes = c.slice_mut(memory.cast::<u8>(), len, mpca_status::BadLength)?;
         let number = handle::reserve()?;
         let world = World::init_from_image(image, bytes)?;
-        *out = handle::issue(number, world);
+        out.set(handle::issue(number, world));
         Ok(())
     })
 }

@@ -2,7 +2,7 @@
 
 use mpca_core::World;
 
-use crate::{check_size, guard, handle, mpca_desc, mpca_status, read, write};
+use crate::{check_size, guard, handle, mpca_desc, mpca_status};
 
 /// An opaque world, reached through its handle: the `mpca_world *` that
 /// mpca_world_create or mpca_world_init wrote. A handle is only ever passed
@@ -43,26 +43,6 @@ pub struct mpca_world {
     _opaque: [u8; 0],
 }
 
-/// The world behind a handle: NULL and dead handles are refused.
-pub(crate) unsafe fn world_mut<'a>(w: *mut mpca_world) -> Result<&'a mut World, mpca_status> {
-    if w.is_null() {
-        return Err(mpca_status::NullPointer);
-    }
-    let at = handle::resolve(w)?;
-    // SAFETY: hosted builds: `at` is where a world was built and registered,
-    // and its handle was not revoked since, so the memory is that world's
-    // (the C contract: memory handed to mpca_world_init stays until deinit).
-    // Firmware builds: the C contract that a handle is an address this
-    // library returned, still readable. Either way the tag is checked before
-    // anything else is read.
-    unsafe { World::from_ptr(at) }.map_err(|_| mpca_status::BadHandle)
-}
-
-/// Read-only twin of [`world_mut`].
-pub(crate) unsafe fn world_ref<'a>(w: *const mpca_world) -> Result<&'a World, mpca_status> {
-    unsafe { world_mut(w.cast_mut()) }.map(|w| &*w)
-}
-
 /// Builds an empty world in `memory` (`len` bytes, any alignment, at least
 /// mpca_world_bytes; more than PTRDIFF_MAX is refused with
 /// `MPCA_STATUS_BAD_LENGTH`) and writes its handle to `out_world`. Nothing is
@@ -77,13 +57,13 @@ pub unsafe extern "C" fn mpca_world_init(
     len: usize,
     out_world: *mut *mut mpca_world,
 ) -> mpca_status {
-    guard(|| {
-        let d = unsafe { read(desc)? }.to_core()?;
-        let out = unsafe { write(out_world)? };
-        let bytes = unsafe { crate::slice_mut(memory.cast::<u8>(), len, mpca_status::BadLength)? };
+    guard(|c| {
+        let d = c.get(desc)?.to_core()?;
+        let out = c.out(out_world)?;
+        let bytes = c.slice_mut(memory.cast::<u8>(), len, mpca_status::BadLength)?;
         let number = handle::reserve()?;
         let world = World::init(&d, bytes)?;
-        *out = handle::issue(number, world);
+        out.set(handle::issue(number, world));
         Ok(())
     })
 }
@@ -93,8 +73,8 @@ pub unsafe extern "C" fn mpca_world_init(
 /// mpca_world_create is refused with `MPCA_STATUS_BAD_HANDLE`: destroy it.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_world_deinit(world: *mut mpca_world) -> mpca_status {
-    guard(|| {
-        let w = unsafe { world_mut(world)? };
+    guard(|c| {
+        let w = c.world(world)?;
         if w.is_owned() {
             return Err(mpca_status::BadHandle);
         }
@@ -110,14 +90,13 @@ pub unsafe extern "C" fn mpca_world_deinit(world: *mut mpca_world) -> mpca_statu
 #[cfg(feature = "std")]
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_world_create(desc: *const mpca_desc, out_world: *mut *mut mpca_world) -> mpca_status {
-    guard(|| {
-        let d = unsafe { read(desc)? }.to_core()?;
-        let out = unsafe { write(out_world)? };
+    guard(|c| {
+        let d = c.get(desc)?.to_core()?;
+        let out = c.out(out_world)?;
         let number = handle::reserve()?;
-        let mut world = mpca_core::WorldBox::new(&d)?;
-        *out = handle::issue(number, &mut world);
+        let world = mpca_core::WorldBox::new(&d)?;
         // Owned through the handle from now on; mpca_world_destroy frees it.
-        let _ = world.into_raw();
+        out.set(handle::issue_owned(number, world));
         Ok(())
     })
 }
@@ -128,13 +107,14 @@ pub unsafe extern "C" fn mpca_world_create(desc: *const mpca_desc, out_world: *m
 #[cfg(feature = "std")]
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_world_destroy(world: *mut mpca_world) -> mpca_status {
-    guard(|| {
+    guard(|_| {
         if world.is_null() {
             return Ok(());
         }
         let at = handle::resolve(world)?;
-        // SAFETY: the registry holds `at` for a live handle (see world_mut);
-        // from_raw checks the tag, and that the library allocated it.
+        // SAFETY: the registry holds `at` for a live handle (as in
+        // `Call::world`); from_raw checks the tag, and that the library
+        // allocated it.
         let owned = unsafe { mpca_core::WorldBox::from_raw(at)? };
         handle::revoke(world);
         drop(owned);
@@ -145,8 +125,8 @@ pub unsafe extern "C" fn mpca_world_destroy(world: *mut mpca_world) -> mpca_stat
 /// Advances the world `steps` steps.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_world_step(world: *mut mpca_world, steps: u64) -> mpca_status {
-    guard(|| {
-        unsafe { world_mut(world)? }.step(steps);
+    guard(|c| {
+        c.world(world)?.step(steps);
         Ok(())
     })
 }
@@ -155,9 +135,9 @@ pub unsafe extern "C" fn mpca_world_step(world: *mut mpca_world, steps: u64) -> 
 /// made since by the set functions) to `out`.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_world_desc(world: *const mpca_world, out: *mut mpca_desc) -> mpca_status {
-    guard(|| {
-        let w = unsafe { world_ref(world)? };
-        *unsafe { write(out)? } = mpca_desc::from_core(w.description());
+    guard(|c| {
+        let w = c.world_ref(world)?;
+        c.out(out)?.set(mpca_desc::from_core(w.description()));
         Ok(())
     })
 }
@@ -205,13 +185,14 @@ pub struct mpca_stats {
 /// Fills `out` (whose `struct_size` the caller set) with the statistics.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_world_stats(world: *const mpca_world, out: *mut mpca_stats) -> mpca_status {
-    guard(|| {
-        let w = unsafe { world_ref(world)? };
-        let out = unsafe { write(out)? };
-        check_size::<mpca_stats>(out.struct_size)?;
+    guard(|c| {
+        let w = c.world_ref(world)?;
+        // The caller set the leading struct_size; the rest may be anything.
+        let size = *c.get(out.cast_const().cast::<u32>())?;
+        check_size::<mpca_stats>(size)?;
         let s = w.stats();
-        *out = mpca_stats {
-            struct_size: out.struct_size,
+        c.out(out)?.set(mpca_stats {
+            struct_size: size,
             reserved: 0,
             step: s.step,
             particles: s.particles,
@@ -228,7 +209,7 @@ pub unsafe extern "C" fn mpca_world_stats(world: *const mpca_world, out: *mut mp
             kinetic_energy: s.kinetic_energy,
             clamp_energy: s.clamp_energy,
             bytes_per_cell: s.bytes_per_cell,
-        };
+        });
         Ok(())
     })
 }
@@ -237,9 +218,9 @@ pub unsafe extern "C" fn mpca_world_stats(world: *const mpca_world, out: *mut mp
 /// lifetime: equal worlds hash equal on every target and through every API.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_world_hash(world: *const mpca_world, out_hash: *mut u64) -> mpca_status {
-    guard(|| {
-        let w = unsafe { world_ref(world)? };
-        *unsafe { write(out_hash)? } = w.state_hash();
+    guard(|c| {
+        let w = c.world_ref(world)?;
+        c.out(out_hash)?.set(w.state_hash());
         Ok(())
     })
 }
@@ -276,19 +257,19 @@ pub unsafe extern "C" fn mpca_world_region_stats(
     max: *const u32,
     out: *mut mpca_region_stats,
 ) -> mpca_status {
-    guard(|| {
-        let w = unsafe { world_ref(world)? };
-        let (min, max) = unsafe { (crate::array(min)?, crate::array(max)?) };
-        let out = unsafe { write(out)? };
-        check_size::<mpca_region_stats>(out.struct_size)?;
+    guard(|c| {
+        let w = c.world_ref(world)?;
+        let (min, max) = (c.array(min)?, c.array(max)?);
+        let size = *c.get(out.cast_const().cast::<u32>())?;
+        check_size::<mpca_region_stats>(size)?;
         let r = w.region_stats(min, max)?;
-        *out = mpca_region_stats {
-            struct_size: out.struct_size,
+        c.out(out)?.set(mpca_region_stats {
+            struct_size: size,
             reserved: 0,
             particles: r.particles,
             momentum: r.momentum,
             kinetic_energy: r.kinetic_energy,
-        };
+        });
         Ok(())
     })
 }
