@@ -72,8 +72,12 @@ pub(crate) struct Shared<'a> {
     pub drag: Option<([f32; 3], Option<Vortex>, f32)>,
     /// The 8-bit move table of the drift rule (M5.3).
     pub moves: &'static [u16; 256],
-    /// One mass, no lifetimes: blocks away from the faces and without an
-    /// obstacle go through [`Kernel::lean`].
+    /// Forces other than a uniform one (fields, potentials, the vortex,
+    /// drag) are summed per particle, in [`Kernel::general`].
+    pub summed: bool,
+    /// One mass, no lifetimes, no summed force: blocks away from the faces
+    /// and without an obstacle go through [`Kernel::lean`] (or
+    /// [`Kernel::lean_2d`]).
     pub plain: bool,
 }
 
@@ -91,11 +95,12 @@ pub(crate) struct Writable<'a, Q, const D: usize> {
 }
 
 /// The block routine, specialised once per step (M9) on the stored velocity
-/// type `Q`, the dimension `D` (with `CELLS = 2^D` cells a block) and
-/// whether forces other than a uniform one are summed (`GENERAL`).
-/// Obstacles, per-particle masses and lifetimes are per-step switches: each
-/// costs a predictable branch per block or per particle when it is off.
-pub(crate) struct Kernel<'a, Q, const D: usize, const CELLS: usize, const GENERAL: bool> {
+/// type `Q` and the dimension `D` (with `CELLS = 2^D` cells a block).
+/// Summed forces, obstacles, per-particle masses and lifetimes are per-step
+/// switches: each costs a predictable branch per block or per particle in
+/// the general routine, and sends every block there when it is on
+/// ([`Shared::plain`]), so the lean routines never test them.
+pub(crate) struct Kernel<'a, Q, const D: usize, const CELLS: usize> {
     pub shared: &'a Shared<'a>,
     pub planes: Writable<'a, Q, D>,
     pub counters: Counters,
@@ -368,7 +373,7 @@ impl<const D: usize, const CELLS: usize> Block<D, CELLS> {
     }
 }
 
-impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'_, Q, D, CELLS, GENERAL> {
+impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
     const ALL: u8 = {
         assert!(CELLS == 1 << D && (D == 2 || D == 3));
         (u8::MAX as usize >> (8 - CELLS)) as u8
@@ -867,7 +872,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
 
         // M5.1 external force: v <- v + dt F / m (eqs. 4-5).
         for c in cells_of(occ) {
-            let dv = if GENERAL {
+            let dv = if sh.summed {
                 let pos = sh.part.cell_coords(row, [xs[c & 1], 0, 0], c);
                 // dt = 0 changes nothing, even under an infinite force
                 // (0 * inf would be NaN).
@@ -967,7 +972,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Kernel<'
     }
 }
 
-impl<'a, Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> BlockSink<'a> for Kernel<'a, Q, D, CELLS, GENERAL> {
+impl<'a, Q: Quant, const D: usize, const CELLS: usize> BlockSink<'a> for Kernel<'a, Q, D, CELLS> {
     const CELLS: usize = CELLS;
 
     fn index(&self) -> Index<'a> {
@@ -977,7 +982,7 @@ impl<'a, Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool> Bloc
     #[inline(always)]
     fn visit(&mut self, row: &BlockRow, x0: isize, bx: usize, occ: u8) {
         let sh = self.shared;
-        if !GENERAL && sh.plain && row.outside == 0 && x0 >= 0 {
+        if sh.plain && row.outside == 0 && x0 >= 0 {
             let x0 = x0 as usize;
             if D == 2 && Q::LANES {
                 // 2D, 8 bits: the lanes routine or the general one (the

@@ -3,9 +3,10 @@
 //! counters and the step number.
 //!
 //! The description fixes, once per step, which specialised block routine
-//! runs (M9): the stored velocity width, the dimension and the force path
-//! are compile-time parameters of [`Kernel`], so a scene pays nothing in its
-//! inner loop for the parts it does not use.
+//! runs (M9): the stored velocity width and the dimension are compile-time
+//! parameters of [`Kernel`]; the force path and the optional parts are
+//! switches read once per block at most, and a world without them sends its
+//! blocks through the lean routines, which have no code for them.
 
 use crate::cells::Cells;
 use crate::layout::Layout;
@@ -138,8 +139,8 @@ impl World {
         crate::quant::with_quant!(self.head.desc.quantization, Q => {
             match self.head.desc.dim {
                 #[cfg(feature = "dim3")]
-                3 => with_force::<Q, 3, 8>(self, route, split),
-                _ => with_force::<Q, 2, 4>(self, route, split),
+                3 => run::<Q, 3, 8>(self, route, split),
+                _ => run::<Q, 2, 4>(self, route, split),
             }
         });
         self.head.step += 1;
@@ -170,6 +171,9 @@ impl World {
         };
         let dt_q = desc.dt * Q::SCALE;
         let push = terms.gravity.map(|g| if dt_q == 0.0 { 0.0 } else { g * dt_q });
+        // Fields, potentials, the vortex and drag are summed per particle;
+        // a uniform force alone is one precomputed change (`push`).
+        let summed = cfg!(feature = "fields") && (desc.forces.any_field() || desc.drag.rate > 0.0);
         let shared = Shared {
             desc,
             n,
@@ -186,7 +190,8 @@ impl World {
                 (wind, desc.drag.vortex.then_some(desc.vortex), desc.dt * desc.drag.rate)
             }),
             moves: crate::quant::move_table_8(desc.drift),
-            plain: route.lean && !desc.per_particle_mass && !desc.lifetimes,
+            summed,
+            plain: route.lean && !desc.per_particle_mass && !desc.lifetimes && !summed,
         };
         let planes = Writable {
             occupancy: Cells::new(occupancy),
@@ -205,20 +210,10 @@ impl World {
     }
 }
 
-/// Picks the force path (M9): fields, potentials and the vortex are summed
-/// per particle; a uniform force alone is one precomputed change.
-fn with_force<Q: Quant, const D: usize, const CELLS: usize>(w: &mut World, route: Route, split: Split<'_>) {
-    #[cfg(feature = "fields")]
-    if w.head.desc.forces.any_field() || w.head.desc.drag.rate > 0.0 {
-        return run::<Q, D, CELLS, true>(w, route, split);
-    }
-    run::<Q, D, CELLS, false>(w, route, split)
-}
-
-fn run<Q: Quant, const D: usize, const CELLS: usize, const GENERAL: bool>(w: &mut World, route: Route, split: Split<'_>) {
+fn run<Q: Quant, const D: usize, const CELLS: usize>(w: &mut World, route: Route, split: Split<'_>) {
     w.sweep_with::<Q, D>(route, |shared, planes, reverse| {
         let sweep = |band| {
-            let mut kernel = Kernel::<Q, D, CELLS, GENERAL> { shared, planes, counters: Counters::default() };
+            let mut kernel = Kernel::<Q, D, CELLS> { shared, planes, counters: Counters::default() };
             shared.part.sweep_band(&mut kernel, band, reverse, route.skip);
             kernel.counters
         };
