@@ -128,6 +128,20 @@ const BLOCKED_KEY_2D: [u16; 16] = {
     t
 };
 
+/// `field` shifted to cell `c`'s place (`width` bits a cell) for each cell
+/// `c` set in `mask`, together: the per-mask tables below.
+const fn per_cell(mask: usize, width: u32, field: u64) -> u64 {
+    let mut out = 0;
+    let mut c = 0;
+    while c < 8 {
+        if mask >> c & 1 != 0 {
+            out |= field << (width * c);
+        }
+        c += 1;
+    }
+    out
+}
+
 /// Targets of a block's cells, 4 bits a cell (cell `c` goes to
 /// `targets >> 4c & 7`): per occupancy mask the bits that belong to
 /// occupied cells, and the targets that leave every particle in place.
@@ -135,13 +149,7 @@ const FIELDS: [u32; 256] = {
     let mut t = [0; 256];
     let mut mask = 0;
     while mask < 256 {
-        let mut c = 0;
-        while c < 8 {
-            if mask >> c & 1 != 0 {
-                t[mask] |= 0xf << (4 * c);
-            }
-            c += 1;
-        }
+        t[mask] = per_cell(mask, 4, 0xf) as u32;
         mask += 1;
     }
     t
@@ -186,13 +194,7 @@ const LANES_2D: [u64; 16] = {
     let mut t = [0; 16];
     let mut mask = 0;
     while mask < 16 {
-        let mut c = 0;
-        while c < 4 {
-            if mask >> c & 1 != 0 {
-                t[mask] |= 0xffff << (16 * c);
-            }
-            c += 1;
-        }
+        t[mask] = per_cell(mask, 16, 0xffff);
         mask += 1;
     }
     t
