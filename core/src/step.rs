@@ -143,7 +143,9 @@ impl World {
                 _ => run::<Q, 2, 4>(self, route, split),
             }
         });
-        self.head.step += 1;
+        // An image may carry any step number (M12): after 2^64 - 1 the
+        // count wraps to 0 (the parity of M3 goes on alternating).
+        self.head.step = self.head.step.wrapping_add(1);
     }
 
     /// Runs `visit` over the step's partition with the step's shared data and

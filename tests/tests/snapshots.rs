@@ -678,3 +678,21 @@ fn the_format_of_version_1_is_pinned() {
     println!("small world at step 0: image {} bytes, crc {crc:08x}", img.len());
     assert_eq!((img.len(), crc), (4318, 0xae75_905c));
 }
+
+#[test]
+fn a_world_loaded_at_the_last_step_number_steps_on_to_step_zero() {
+    // Found by the snapshot fuzzer: an image may carry any step number, and
+    // stepping a world loaded at u64::MAX overflowed the count. It wraps.
+    let desc = Description::new_2d(16, 16);
+    let mut memory = vec![0u8; world_bytes(&desc).unwrap()];
+    let w = World::init(&desc, &mut memory).unwrap();
+    w.add_particle([3, 4, 0], [0.5, 0.0, 0.0]).unwrap();
+    let mut img = image(w);
+    assert_eq!(u64_at(&img, STATE_AT), 0, "the state starts with the step number");
+    img[STATE_AT..STATE_AT + 8].copy_from_slice(&u64::MAX.to_le_bytes());
+    reseal(&mut img);
+    w.load(&img).unwrap();
+    assert_eq!(w.stats().step, u64::MAX);
+    w.step(2);
+    assert_eq!((w.stats().step, w.stats().particles), (1, 1));
+}
