@@ -144,7 +144,8 @@ impl World {
                 }
             };
             each_site(&l, &e, |s| chosen(self, s));
-            self.head.counters.emitted += placing;
+            // Saturating: an image (M12) may carry any count.
+            self.head.counters.emitted = self.head.counters.emitted.saturating_add(placing);
             self.head.counters.particles += placing;
         }
     }

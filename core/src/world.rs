@@ -30,15 +30,16 @@ pub(crate) struct Counters {
 }
 
 impl Counters {
-    /// Adds what a sweep of blocks counts (a task's share of a step).
+    /// Adds what a sweep of blocks counts (a task's share of a step). The
+    /// running totals saturate: an image (M12) may carry any count.
     pub fn add_step(&mut self, c: &Counters) {
-        self.exited += c.exited;
-        self.expired += c.expired;
-        self.collisions += c.collisions;
-        self.clamps += c.clamps;
+        self.exited = self.exited.saturating_add(c.exited);
+        self.expired = self.expired.saturating_add(c.expired);
+        self.collisions = self.collisions.saturating_add(c.collisions);
+        self.clamps = self.clamps.saturating_add(c.clamps);
         self.clamp_energy = self.clamp_energy.saturating_add(c.clamp_energy);
-        self.displaced += c.displaced;
-        self.processed += c.processed;
+        self.displaced = self.displaced.saturating_add(c.displaced);
+        self.processed = self.processed.saturating_add(c.processed);
     }
 }
 

@@ -696,3 +696,29 @@ fn a_world_loaded_at_the_last_step_number_steps_on_to_step_zero() {
     w.step(2);
     assert_eq!((w.stats().step, w.stats().particles), (1, 1));
 }
+
+#[test]
+fn counts_loaded_at_their_largest_saturate_as_the_world_steps() {
+    // Found by the snapshot fuzzer: an image may carry any running count,
+    // and adding a step's collisions to u64::MAX overflowed. Every count
+    // of the image's state (emitted ... clamps) set to u64::MAX; a dense
+    // emitting gas then collides, exits and emits on.
+    let mut desc = Description::new_2d(16, 16).with_boundary(Boundary::Open);
+    desc.emitter_capacity = 1;
+    let mut memory = vec![0u8; world_bytes(&desc).unwrap()];
+    let w = World::init(&desc, &mut memory).unwrap();
+    w.add_emitter(Emitter { min: [0, 0, 0], max: [16, 16, 1], rate: 100.0, velocity: [0.5, 0.0, 0.0], spread: 0.3, mass: 1.0, lifetime: 0 })
+        .unwrap();
+    w.step(3);
+    let mut img = image(w);
+    // After the particle count: emitted, exited, expired, shortfall,
+    // collisions, clamps.
+    for k in 1..7 {
+        img[PARTICLES_AT + 8 * k..PARTICLES_AT + 8 * k + 8].copy_from_slice(&u64::MAX.to_le_bytes());
+    }
+    reseal(&mut img);
+    w.load(&img).unwrap();
+    w.step(5);
+    let s = w.stats();
+    assert!(s.collisions == u64::MAX && s.emitted == u64::MAX && s.exited == u64::MAX, "{s:?}");
+}
