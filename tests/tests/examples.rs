@@ -32,26 +32,16 @@ use mpca_tests::scenes::{Scene, build, paper_scenes};
 /// What to install when the headers are missing (Debian, Ubuntu).
 const INSTALL: &str = "apt-get install -y libosmesa6-dev libpng-dev libgif-dev";
 
-/// The C compiler cc picks for this target.
-fn c_compiler() -> cc::Tool {
+/// The C compiler cc picks for this target, or its C++ compiler (for
+/// cpp_example.cpp).
+fn compiler(cpp: bool) -> cc::Tool {
     cc::Build::new()
         .cargo_metadata(false)
         .cargo_warnings(false)
         .target(env!("MPCA_TEST_TARGET"))
         .host(env!("MPCA_TEST_HOST"))
         .opt_level(2)
-        .get_compiler()
-}
-
-/// The C++ compiler cc picks for this target (for cpp_example.cpp).
-fn cpp_compiler() -> cc::Tool {
-    cc::Build::new()
-        .cargo_metadata(false)
-        .cargo_warnings(false)
-        .target(env!("MPCA_TEST_TARGET"))
-        .host(env!("MPCA_TEST_HOST"))
-        .opt_level(2)
-        .cpp(true)
+        .cpp(cpp)
         .get_compiler()
 }
 
@@ -86,7 +76,7 @@ fn programs() -> &'static Path {
     DIR.get_or_init(|| {
         let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("c_examples");
         std::fs::create_dir_all(&dir).expect("create the build folder");
-        let cc = c_compiler();
+        let cc = compiler(false);
         check_build_dependencies(&cc, &dir);
         let lib = library();
         let out = Command::new("make")
@@ -94,7 +84,7 @@ fn programs() -> &'static Path {
             .arg(format!("MPCA_LIB={}", lib.display()))
             .arg(format!("BUILD={}", dir.display()))
             .arg(format!("CC={}", cc.path().display()))
-            .arg(format!("CXX={}", cpp_compiler().path().display()))
+            .arg(format!("CXX={}", compiler(true).path().display()))
             .output()
             .expect("make runs");
         assert!(
