@@ -7,11 +7,34 @@
 #
 #   scripts/instructions.sh                 every scene
 #   scripts/instructions.sh aggregation     one scene (aggregation, cluster, smoke, water)
+#   scripts/instructions.sh --assign        M5.6 alone: instructions per 3D block
+#                                           by particles per block, exact-fast
+#                                           against greedy (issue 8's ratio)
 #
 # Installs valgrind with apt-get when it is missing.
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 command -v valgrind >/dev/null || scripts/install-missing.sh valgrind
+
+if [ "${1:-}" = "--assign" ]; then
+    cargo build --release -q -p mpca-tests --bin assign_blocks
+    out=$(mktemp -d)
+    trap 'rm -rf "$out"' EXIT
+    blocks=4000
+    # Instructions per block of `solve` for (K, METHOD), 3D random blocks.
+    per_block() {
+        valgrind --tool=callgrind --callgrind-out-file="$out/cg" --collect-atstart=no \
+            --toggle-collect='*assign_blocks*solve*' target/release/assign_blocks 3 "$1" "$2" $blocks >/dev/null 2>&1
+        awk -v n=$blocks '/^(summary|totals):/{printf "%.0f", $2 / n; exit}' "$out/cg"
+    }
+    printf '%-10s %12s %12s %8s\n' particles exact-fast greedy ratio
+    for k in 1 2 3 4 5 6 7 8; do
+        e=$(per_block "$k" exact-fast)
+        g=$(per_block "$k" greedy)
+        awk -v k="$k" -v e="$e" -v g="$g" 'BEGIN { printf "%-10s %12d %12d %8.2f\n", k, e, g, e / g }'
+    done
+    exit 0
+fi
 
 bench=$(cargo bench -p mpca-tests --bench scenes --no-run --message-format=json 2>/dev/null |
     grep '"kind":\["bench"\]' | sed -n 's/.*"executable":"\([^"]*\)".*/\1/p' | tail -1)
