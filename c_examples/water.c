@@ -7,6 +7,13 @@
  * at v = (0, -0.3, 0). At another --size every length scales with it and
  * the rate with the emitter's area.
  *
+ * Built a second time with -DWATER_POOL as `water-pool` (M5.7 contacts,
+ * beyond the paper; tests/src/scenes.rs `water_pool()`): no emitter, but a
+ * 24 x 16 x 24 block of water released at rest above the sphere (x and z
+ * 20..44, y 44..60), gravity 0.002, e = 0.5 for the water, the walls and
+ * the sphere, contacts on, the default (calibrated) drift. It splashes off
+ * the sphere and forms a pool on the floor.
+ *
  * Drawn in perspective from above and in front: the floor with a grid, the
  * box's edges and the sphere in greys, the water as point sprites coloured
  * by speed and darkened with distance.
@@ -35,6 +42,45 @@ static water_geometry geometry(uint32_t size) {
     return g;
 }
 
+#ifdef WATER_POOL
+static mpca_world *build(const scene_opts *o) {
+    const water_geometry g = geometry(o->size);
+    const float e = 0.5f;
+    mpca_desc d;
+    mpca_check(mpca_desc_defaults(&d, 3, o->size, o->size, o->size), "mpca_desc_defaults");
+    for (int axis = 0; axis < 3; axis++) {
+        d.boundary[axis][0] = d.boundary[axis][1] = MPCA_BOUNDARY_WALL;
+    }
+    d.restitution = e;
+    d.wall_restitution = e;
+    d.contacts = 1;
+    d.forces = MPCA_FORCE_UNIFORM;
+    d.gravity[1] = -0.002f;
+    d.obstacles = 1;
+    float area = (float)o->size / PAPER_SIZE;
+    area *= area;
+    d.surface_capacity = area > 1.0f ? (uint32_t)ceilf(4096.0f * area) : 4096;
+    d.seed = o->seed;
+    mpca_world *w = world_create(&d);
+    mpca_check(mpca_world_add_sphere(w, g.centre, g.radius, e), "mpca_world_add_sphere");
+    const uint32_t lo[3] = {20, 44, 20}, hi[3] = {44, 60, 44};
+    uint32_t min[3], max[3];
+    for (int k = 0; k < 3; k++) {
+        min[k] = scale_cells(lo[k], o->size, PAPER_SIZE);
+        max[k] = scale_cells(hi[k], o->size, PAPER_SIZE);
+    }
+    const float rest[3] = {0.0f, 0.0f, 0.0f};
+    for (uint32_t y = min[1]; y < max[1]; y++) {
+        for (uint32_t z = min[2]; z < max[2]; z++) {
+            for (uint32_t x = min[0]; x < max[0]; x++) {
+                const uint32_t pos[3] = {x, y, z};
+                mpca_check(mpca_world_add_particle(w, pos, rest), "mpca_world_add_particle");
+            }
+        }
+    }
+    return w;
+}
+#else
 static mpca_world *build(const scene_opts *o) {
     const water_geometry g = geometry(o->size);
     mpca_desc d;
@@ -69,6 +115,7 @@ static mpca_world *build(const scene_opts *o) {
     mpca_check(mpca_world_add_emitter(w, &e, &index), "mpca_world_add_emitter");
     return w;
 }
+#endif
 
 /* From the front, to one side and above, aimed a little below the sphere's
  * centre so the falling column, the sphere and the splash on the floor all
@@ -100,6 +147,17 @@ static drawn draw(const scene_opts *o, mpca_world *w, const view *v) {
 }
 
 int main(int argc, char **argv) {
+#ifdef WATER_POOL
+    const scene s = {
+        .name = "water-pool",
+        .title = "4.4 water poured into a pool (M5.7)",
+        .dim = 3,
+        .defaults = {.size = PAPER_SIZE, .steps = 1200, .seed = 45, .every = 100, .tiles = 6, .px = 512},
+        .about = "3D box, a block of water released above a sphere under gravity, e = 0.5, contacts: it splashes and pools on the floor",
+        .build = build,
+        .draw = draw,
+    };
+#else
     const scene s = {
         .name = "water",
         .title = "4.4 water",
@@ -109,5 +167,6 @@ int main(int argc, char **argv) {
         .build = build,
         .draw = draw,
     };
+#endif
     return scene_main(&s, argc, argv);
 }

@@ -112,6 +112,47 @@ fn contacts_let_a_pool_settle() {
     assert!(speed < 0.6 * paper_speed, "mean |v| {speed} against the paper's {paper_speed}");
 }
 
+/// M5.7 under weaker gravity: the same poured pool at g = 0.001 comes to
+/// rest, mean |v| at most 0.05 after 2,400 steps (measured 0.041) and no
+/// clamp, as sqrt(h g) says: at g = 0.01 it stays near 0.12.
+#[test]
+fn a_pool_under_weak_gravity_comes_to_rest() {
+    let (speed, clamps) = poured(&pool(true, 0.001, 0.5), 2400);
+    assert!(speed <= 0.05, "mean |v| {speed}");
+    assert!(clamps <= 0.01, "clamps per particle-step {clamps}");
+}
+
+/// The poured water scene (scenes::water_pool): a block of water released
+/// above the sphere splashes off it and ends as a pool on the floor, in a
+/// closed box: after 1,200 steps every particle lies below y = 10, no
+/// clamp fires (the issue asks at most 1 % of
+/// particle-steps), and the pool moves at a mean speed below 0.1 (measured
+/// 0.074). Under the paper's rules (no contacts, e = 1) the same water
+/// still bounces round the box: 29 % of it below y = 10, mean speed 0.43.
+#[test]
+fn poured_water_forms_a_pool_on_the_floor() {
+    let outcome = |scene: &Scene| {
+        let mut memory = Vec::new();
+        let w = scenes::build(scene, &mut memory).unwrap();
+        let n = w.particle_count();
+        w.step(scene.steps);
+        assert_eq!(w.particle_count(), n, "nothing leaves a closed box");
+        let low = w.particles().filter(|p| p.pos[1] < 10).count() as u64;
+        (low as f64 / n as f64, mean_speed(w), w.stats().clamps as f64 / (n * scene.steps) as f64)
+    };
+    let scene = scenes::water_pool();
+    let (low, speed, clamps) = outcome(&scene);
+    let mut paper = scene;
+    paper.desc.contacts = false;
+    paper.desc.restitution = 1.0;
+    paper.desc.wall_restitution = 1.0;
+    let (paper_low, paper_speed, _) = outcome(&paper);
+    assert_eq!(low, 1.0, "share of the water below y = 10");
+    assert!(clamps <= 0.01, "clamps per particle-step {clamps}");
+    assert!(speed < 0.1, "mean |v| {speed}");
+    assert!(paper_low < 0.5 && paper_speed > 0.3, "paper's rules: {paper_low} below y = 10, mean |v| {paper_speed}");
+}
+
 /// M5.7 keeps momentum up to rounding: a dense periodic gas drifting at
 /// (0.3, 0.1) without force, e = 0.9, speed-limited collisions and speeds
 /// below 0.62, so that no clamp changes momentum (an elastic contact can

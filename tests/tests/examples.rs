@@ -438,7 +438,8 @@ fn density_haze_is_grey_background_where_empty_and_under_the_particles() {
 /// bit (`mpca_world_hash` against `World::state_hash`), as the scene of
 /// tests/src/scenes.rs after the same steps; stepped serially, and in the
 /// parallel step (M11) on 1, 2 and 3 POSIX threads (4, 8 and 12 tasks).
-/// The same for `smoke-flow`, the smoke with flow drag (M5.1b).
+/// The same for `smoke-flow`, the smoke with flow drag (M5.1b), and
+/// `water-pool`, the water poured into a pool with contacts (M5.7).
 #[test]
 fn the_c_scenes_are_the_rust_scenes() {
     const STEPS: u64 = 6;
@@ -446,6 +447,7 @@ fn the_c_scenes_are_the_rust_scenes() {
     let out_s = out_dir.to_string_lossy().into_owned();
     let mut scenes: Vec<Scene> = paper_scenes().into();
     scenes.push(mpca_tests::scenes::smoke_flow());
+    scenes.push(mpca_tests::scenes::water_pool());
     let mut memory = Vec::new();
     for scene in &scenes {
         let world = build(scene, &mut memory).expect("the Rust scene builds");
