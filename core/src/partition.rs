@@ -238,7 +238,11 @@ impl Partition {
     pub fn sweep_band<'a, S: BlockSink<'a>>(&self, sink: &mut S, band: Range<usize>, reverse: bool, skip: bool) {
         let idx = sink.index();
         let [ax, ay, az] = self.axes;
-        let layers = if self.dim == 3 { 2 } else { 1 };
+        // The dimension as a constant of the sink, so that the loops over a
+        // row's layers unroll and the cell masks fold.
+        let dim = if S::CELLS == 8 { 3 } else { 2 };
+        debug_assert_eq!(dim, self.dim);
+        let layers = dim - 1;
         let total = band.len();
         let mut j = 0;
         while j < total {
@@ -253,7 +257,7 @@ impl Partition {
             for dz in 0..layers {
                 for dy in 0..2 {
                     if (y_out >> dy | z_out >> dz) & 1 != 0 {
-                        outside |= cells_at(1, dy, self.dim) & cells_at(2, dz, self.dim);
+                        outside |= cells_at(1, dy, dim) & cells_at(2, dz, dim);
                         continue;
                     }
                     let l = ys[dy] + ay.n * zs[dz];
@@ -272,7 +276,7 @@ impl Partition {
             // four at a time where their flags say so. Rows of blocks from
             // i to the band's edge, i included.
             let room = if reverse { i - band.start + 1 } else { band.end - i };
-            j += self.empty_run(idx.rows, by, bz, reverse, room).max(1);
+            j += self.empty_run::<S>(idx.rows, by, bz, reverse, room).max(1);
         }
     }
 
@@ -282,10 +286,10 @@ impl Partition {
     /// sure: a multiple of four, their rows read eight flags at a time, at
     /// most 32.
     #[inline]
-    fn empty_run(&self, rows: Cells<'_, u8>, by: usize, bz: usize, reverse: bool, room: usize) -> usize {
+    fn empty_run<'a, S: BlockSink<'a>>(&self, rows: Cells<'_, u8>, by: usize, bz: usize, reverse: bool, room: usize) -> usize {
         let [_, ay, az] = self.axes;
         let (zs, z_out) = self.axis_pair(2, az.first + 2 * bz as isize);
-        let layers = if self.dim == 3 { 2 } else { 1 };
+        let layers = if S::CELLS == 8 { 2 } else { 1 };
         let mut run = 0;
         while run < 32 && run + 4 <= room {
             // The four rows of blocks from `low` to `low + 3`.
