@@ -77,11 +77,15 @@ pub(crate) trait Quant: Copy + Default + Send + crate::layout::Plain + 'static {
         }
         if Self::SCALE < 128.0 {
             let y = (x + 128.0) + (r & 0xffff) as f32 * (1.0 / 65536.0);
-            return y as i32 - 128;
+            // SAFETY: x is in [-127, 127] (clamped, and not NaN), so y is
+            // finite and in [1, 256): its integer part fits an i32. (A
+            // checked cast would test for NaN and both bounds again.)
+            return unsafe { y.to_int_unchecked::<i32>() } - 128;
         }
         let x = x * 65536.0;
-        // |x| <= 32767 * 2^16 < 2^31: the cast does not saturate.
-        let fixed = (x + 0.5f32.copysign(x)) as i32;
+        // SAFETY: x is in [-32767, 32767] 2^16 (clamped, not NaN): the sum is
+        // finite and its magnitude below 2^31, so it fits an i32.
+        let fixed = unsafe { (x + 0.5f32.copysign(x)).to_int_unchecked::<i32>() };
         (fixed >> 16) + i32::from(r & 0xffff < (fixed & 0xffff) as u32)
     }
 
