@@ -233,8 +233,15 @@ fn inward_lanes(lanes: u64, occ: u8) -> u8 {
 /// Cell `c`'s velocity from a 2D block's byte lanes, in quanta.
 #[inline(always)]
 fn lane_quanta(lanes: u64, c: usize) -> [f32; 3] {
+    let [x, y] = lane_ints(lanes, c);
+    [f32::from(x), f32::from(y), 0.0]
+}
+
+/// Cell `c`'s stored velocity in byte lanes, as integers.
+#[inline(always)]
+fn lane_ints(lanes: u64, c: usize) -> [i8; 2] {
     let q = (lanes >> (16 * c)) as u16;
-    [f32::from(q as u8 as i8), f32::from((q >> 8) as u8 as i8), 0.0]
+    [q as u8 as i8, (q >> 8) as u8 as i8]
 }
 
 /// Runs `$body` once for each cell of a block of `$cells` cells, with `$c`
@@ -801,10 +808,10 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
                 let t = (targets >> (4 * c) & 7) as usize;
                 after |= 1 << t;
                 if t != c || pending >> c & 1 != 0 {
-                    let q = lane_quanta(lanes, c);
+                    let q = lane_ints(lanes, c);
                     let mut stored = [Q::default(); D];
-                    stored[0] = Q::from_int(q[0] as i32);
-                    stored[1] = Q::from_int(q[1] as i32);
+                    stored[0] = Q::from_int(q[0].into());
+                    stored[1] = Q::from_int(q[1].into());
                     velocity.set(x0 + (t & 1) + row.cell[t >> 1], stored);
                 }
             }
