@@ -714,6 +714,22 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
     #[inline(never)]
     fn change_lanes(&mut self, mut lanes: u64, occ: u8, pair: Option<(usize, usize)>, rng: &mut Stream) -> (u64, u8) {
         let mass = self.shared.desc.mass;
+        // Cell c's lanes replaced by the rounding of x (M1).
+        let round_into = |lanes: u64, c: usize, x: [f32; 3], rng: &mut Stream| {
+            let [qx, qy] = Q::round::<2>(x, rng).map(|q| u64::from(Q::from_int(q).to_int() as u8));
+            lanes & !(0xffff << (16 * c)) | (qx | qy << 8) << (16 * c)
+        };
+        if self.shared.push.is_none() {
+            // The collision alone: its two results rounded in cell order
+            // (a < c in every pair), as the loop below would.
+            let Some((a, c)) = pair else { return (lanes, 0) };
+            debug_assert!(a < c);
+            let Some((xa, xc)) = self.collide_two(lane_quanta(lanes, a), lane_quanta(lanes, c), (mass, mass), true, rng) else {
+                return (lanes, 0);
+            };
+            lanes = round_into(lanes, a, xa, rng);
+            return (round_into(lanes, c, xc, rng), 1 << a | 1 << c);
+        }
         let mut x = [[0.0f32; 3]; CELLS];
         let mut pending = 0u8;
         if let Some(dv) = self.shared.push {
@@ -734,8 +750,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
             }
         }
         for c in cells_of(pending) {
-            let [qx, qy] = Q::round::<2>(x[c], rng).map(|q| u64::from(Q::from_int(q).to_int() as u8));
-            lanes = lanes & !(0xffff << (16 * c)) | (qx | qy << 8) << (16 * c);
+            lanes = round_into(lanes, c, x[c], rng);
         }
         (lanes, pending)
     }
