@@ -868,7 +868,7 @@ fn pick(prices: &Prices, count: usize, draw: impl FnOnce(u32) -> u32) -> Assignm
 }
 
 /// What [`bits`] returns.
-struct Bits(u8);
+pub(crate) struct Bits(u8);
 
 impl Iterator for Bits {
     type Item = usize;
@@ -886,7 +886,7 @@ impl Iterator for Bits {
 
 /// The indices of the set bits of `set`, lowest first.
 #[inline]
-fn bits(set: u8) -> Bits {
+pub(crate) fn bits(set: u8) -> Bits {
     Bits(set)
 }
 

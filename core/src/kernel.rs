@@ -39,7 +39,7 @@
 //!
 //! M5.1 draws nothing.
 
-use crate::assign::{assign_moves, optimal_moves_2d, pick_move, Method, MoveProblem, PLACE_2D};
+use crate::assign::{assign_moves, bits, optimal_moves_2d, pick_move, Bits, Method, MoveProblem, PLACE_2D};
 use crate::cells::Cells;
 use crate::collision::{collide_limited, collide_pair, energy_neutral, pick_pair, random_unit, shares};
 use crate::desc::{Collisions, Description, Vortex};
@@ -263,16 +263,10 @@ macro_rules! each_cell {
     }};
 }
 
-/// Iterates the set bits of a block mask, lowest first.
+/// The cells of a block mask (its set bits), lowest first.
 #[inline]
-pub(crate) fn cells_of(mut mask: u8) -> impl Iterator<Item = usize> {
-    core::iter::from_fn(move || {
-        (mask != 0).then(|| {
-            let c = mask.trailing_zeros() as usize;
-            mask &= mask - 1;
-            c
-        })
-    })
+pub(crate) fn cells_of(mask: u8) -> Bits {
+    bits(mask)
 }
 
 /// The bits of a block in a bit plane, bit `c` for cell `c` (x `xs[c & 1]`
