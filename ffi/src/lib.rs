@@ -20,8 +20,8 @@
 //!   on stderr (`mpca: panicked at FILE:LINE:COLUMN: MESSAGE`) and calls
 //!   `abort()`; it is built with `panic = "abort"` (the workspace's
 //!   profiles set it) and without Rust's `std`, whose panic machinery
-//!   (hook, backtraces, DWARF reader, demangler) would be 42 % of the
-//!   stripped shared library (x86-64 Linux: 683 KB with `std`, 395 KB
+//!   (hook, backtraces, DWARF reader, demangler) would be 43 % of the
+//!   stripped shared library (x86-64 Linux: 670 KB with `std`, 382 KB
 //!   without) and would need `libgcc_s` at run time, for a world the panic
 //!   may have left half stepped anyway (`sys.rs`). With the feature `catch-panics` (which links
 //!   `std`; build it with `panic = "unwind"`) every export runs inside

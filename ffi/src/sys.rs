@@ -7,8 +7,8 @@
 //!
 //! Why not `std`: linking it brings its panic machinery (the default hook,
 //! backtraces, symbol demangling, DWARF parsing): 288 KB of the stripped
-//! shared library on x86-64 Linux (683,008 bytes with `std` and panic =
-//! "abort", 395,472 without), for a panic that is a bug and should end the
+//! shared library on x86-64 Linux (669,760 bytes with `std` and panic =
+//! "abort", 382,120 without), for a panic that is a bug and should end the
 //! program anyway; and it needs GCC's unwinder, `libgcc_s`, at run time.
 //! The feature `catch-panics` builds with `std` and its panic boundary
 //! instead (lib.rs).
