@@ -8,9 +8,12 @@
  * out-of-range values are refused with a status and change nothing.
  * mpca_status_message() turns a status into a static string.
  *
- * Panics: in hosted builds every function runs inside a panic boundary and
- * returns MPCA_STATUS_PANIC instead of unwinding into C; firmware builds
- * (no std) halt on a panic. No input is meant to cause one.
+ * Panics: no input is meant to cause one; one would be a bug. The library
+ * then writes one line on stderr ("mpca: panicked at FILE:LINE:COL: ...")
+ * and calls abort(), as a failed assert does; nothing unwinds into C.
+ * Built with the Cargo feature catch-panics, every function instead
+ * returns MPCA_STATUS_PANIC and the program goes on; firmware builds (no
+ * feature hosted) halt.
  *
  * Buffers: an export that fills a caller's buffer and writes a count takes
  * NULL with capacity 0 as a size query (the count, MPCA_STATUS_OK).
@@ -76,7 +79,8 @@ enum mpca_status
   MPCA_STATUS_BAD_HANDLE = 2,
   /**
    * The library panicked (a bug in mpca); the world may be inconsistent
-   * and should be destroyed.
+   * and should be destroyed. Only a library built with the feature
+   * `catch-panics` returns it: the default one aborts instead.
    */
   MPCA_STATUS_PANIC = 3,
   /**
@@ -471,9 +475,9 @@ typedef uint32_t mpca_cell_kind;
  * back to this library, never dereferenced. (Not `repr(C)`, so cbindgen
  * declares it as an incomplete type.)
  *
- * Hosted builds (the default, with `std`): a handle is a value the library
- * issues, not the world's address, and no value is issued twice in a
- * process. The library keeps a registry of the live ones and asks it before
+ * Hosted builds (the default, feature `hosted`): a handle is a value the
+ * library issues, not the world's address, and no value is issued twice in
+ * a process. The library keeps a registry of the live ones and asks it before
  * it reads any memory, so every value that is not the handle of a live
  * world is refused with `MPCA_STATUS_BAD_HANDLE` (NULL with
  * `MPCA_STATUS_NULL_POINTER`) without a read: the handle of a destroyed or
@@ -485,7 +489,7 @@ typedef uint32_t mpca_cell_kind;
  * worlds in a process; create and init then return
  * `MPCA_STATUS_OUT_OF_MEMORY`.
  *
- * Firmware builds (without `std`: no allocator, no registry): the handle
+ * Firmware builds (without `hosted`: no allocator, no registry): the handle
  * is the world's address in the caller's memory, and the world's header
  * holds a tag tied to that address, which mpca_world_deinit clears.
  * Promised: NULL, and a value not aligned as a world's start, are refused
@@ -833,9 +837,10 @@ const char *mpca_version(void);
 
 #if defined(MPCA_PANIC_TEST)
 /**
- * Panics on purpose, inside the panic boundary, so tests can show that a
- * panic returns `MPCA_STATUS_PANIC` instead of unwinding into C. Only in
- * builds with the `panic-test` feature.
+ * Panics on purpose, so tests can show what a panic does: with
+ * `catch-panics` it returns `MPCA_STATUS_PANIC` instead of unwinding into
+ * C; otherwise the program aborts after one line on stderr. Only in builds
+ * with the `panic-test` feature.
  */
 mpca_status mpca_debug_panic(void);
 #endif
@@ -997,7 +1002,7 @@ mpca_status mpca_world_surface(const struct mpca_world *world,
  *
  * A task the host did not run is run on this thread before the step ends,
  * so a `run_tasks` that returns early still completes the step. Hosted
- * builds only (the default `std` feature).
+ * builds only (the default `hosted` feature).
  */
 mpca_status mpca_world_step_parallel(struct mpca_world *world,
                                      uint64_t steps,
@@ -1204,7 +1209,7 @@ mpca_status mpca_world_deinit(struct mpca_world *world);
 
 /**
  * Allocates and builds an empty world; mpca_world_destroy frees it.
- * Hosted builds only (the default `std` feature): firmware builds have
+ * Hosted builds only (the default `hosted` feature): firmware builds have
  * neither this nor mpca_world_destroy.
  */
 mpca_status mpca_world_create(const struct mpca_desc *desc, struct mpca_world **out_world);

@@ -31,8 +31,9 @@ pub(crate) struct Call<'c> {
     _call: PhantomData<*mut &'c ()>,
 }
 
-/// Runs an export's body inside the panic boundary, with the caller's
-/// promise, and turns its result into a status.
+/// Runs an export's body with the caller's promise, inside the panic
+/// boundary where there is one (`catch-panics`; lib.rs), and turns its
+/// result into a status.
 ///
 /// Called only as the whole body of an export (a `pub extern "C" fn` of
 /// this crate): that is what makes the [`Call`] it hands out true. The
@@ -41,12 +42,12 @@ pub(crate) struct Call<'c> {
 pub(crate) fn guard(body: impl for<'c> FnOnce(&Call<'c>) -> Result<(), mpca_status>) -> mpca_status {
     let call = Call { _call: PhantomData };
     let body = move || body(&call);
-    #[cfg(feature = "std")]
+    #[cfg(feature = "catch-panics")]
     let result = match std::panic::catch_unwind(core::panic::AssertUnwindSafe(body)) {
         Ok(r) => r,
         Err(_) => Err(mpca_status::Panic),
     };
-    #[cfg(not(feature = "std"))]
+    #[cfg(not(feature = "catch-panics"))]
     let result = body();
     match result {
         Ok(()) => mpca_status::Ok,

@@ -14,10 +14,20 @@
 //! - **Bad values** (NaN, infinities, out-of-range numbers, unknown enum
 //!   values, wrong `struct_size`) return a status and leave the world
 //!   unchanged.
-//! - **Panics** never unwind into C. With the default `std` feature every
-//!   export runs inside `catch_unwind` and returns `MPCA_STATUS_PANIC`;
-//!   without it (firmware builds, which abort on panic by target default) a
-//!   panic halts in a spin loop. No input is meant to panic: a panic is a bug.
+//! - **Panics** never unwind into C. No input is meant to panic: a panic is
+//!   a bug (fuzzing has found none since the checked accessors). The
+//!   default build, like a C library whose `assert` fails, writes one line
+//!   on stderr (`mpca: panicked at FILE:LINE:COLUMN: MESSAGE`) and calls
+//!   `abort()`; it is built with `panic = "abort"` (the workspace's
+//!   profiles set it) and without Rust's `std`, whose panic machinery
+//!   (hook, backtraces, DWARF reader, demangler) would be 43 % of the
+//!   stripped shared library (x86-64 Linux: 670 KB with `std`, 382 KB
+//!   without) and would need `libgcc_s` at run time, for a world the panic
+//!   may have left half stepped anyway (`sys.rs`). With the feature `catch-panics` (which links
+//!   `std`; build it with `panic = "unwind"`) every export runs inside
+//!   `catch_unwind` instead and returns `MPCA_STATUS_PANIC`, and the
+//!   program goes on without that world: the C tests build it so. Firmware
+//!   builds (no `hosted`) halt in a spin loop.
 //! - **Threads**: a world may move between threads but must not be used
 //!   from two at once, except for the tasks of a parallel step
 //!   (`parallel.rs`), during which the registry refuses every other call on
@@ -27,8 +37,16 @@
 #![allow(non_camel_case_types)]
 #![allow(clippy::missing_safety_doc)] // the C header is the contract; see each function's docs
 
-#[cfg(feature = "std")]
+// The panic boundary's catch_unwind, and the unit tests' harness.
+#[cfg(any(test, feature = "catch-panics"))]
 extern crate std;
+
+#[cfg(feature = "hosted")]
+extern crate alloc;
+
+// Without std no unwinding exists (rustc refuses the build less clearly).
+#[cfg(all(feature = "hosted", not(any(test, feature = "catch-panics")), panic = "unwind"))]
+compile_error!("libmpca without catch-panics is built with panic = \"abort\" (the workspace's dev and release profiles set it)");
 
 mod call;
 mod desc;
@@ -36,11 +54,15 @@ mod emitters;
 mod forces;
 mod handle;
 mod obstacles;
-#[cfg(feature = "std")]
+#[cfg(feature = "hosted")]
 mod parallel;
 mod particles;
 mod snapshot;
 mod status;
+/// What the library calls in the C library: not part of its header.
+/// cbindgen:ignore
+#[cfg(feature = "hosted")]
+mod sys;
 mod world;
 
 pub(crate) use call::{fits, guard, Call};
@@ -48,7 +70,7 @@ pub use desc::*;
 pub use emitters::*;
 pub use forces::*;
 pub use obstacles::*;
-#[cfg(feature = "std")]
+#[cfg(feature = "hosted")]
 pub use parallel::*;
 pub use particles::*;
 pub use snapshot::*;
@@ -100,18 +122,37 @@ pub(crate) fn check_size<T>(struct_size: u32) -> Result<(), mpca_status> {
     if struct_size as usize == core::mem::size_of::<T>() { Ok(()) } else { Err(mpca_status::BadStructSize) }
 }
 
-#[cfg(not(feature = "std"))]
+/// Hosted builds allocate through the C library (with `std` too, so that
+/// every hosted build, the one the panic-boundary tests use included, runs
+/// the same allocator).
+#[cfg(feature = "hosted")]
+#[global_allocator]
+static ALLOCATOR: sys::CAllocator = sys::CAllocator;
+
+/// Where no `std` provides one (not in unit tests, whose harness links it,
+/// nor with catch-panics, which a cargo build holding the workspace's tests
+/// turns on: tests/Cargo.toml): hosted builds report the panic and abort
+/// (`sys::die`).
+#[cfg(all(feature = "hosted", not(any(test, feature = "catch-panics"))))]
+#[panic_handler]
+fn on_panic(info: &core::panic::PanicInfo<'_>) -> ! {
+    sys::die(info)
+}
+
+#[cfg(not(any(test, feature = "hosted")))]
 #[panic_handler]
 fn on_panic(_: &core::panic::PanicInfo<'_>) -> ! {
-    // Firmware builds: no unwinding exists to cross into C; halt here.
+    // Firmware builds: no unwinding exists to cross into C, nor a stderr;
+    // halt here.
     loop {
         core::hint::spin_loop();
     }
 }
 
-/// Panics on purpose, inside the panic boundary, so tests can show that a
-/// panic returns `MPCA_STATUS_PANIC` instead of unwinding into C. Only in
-/// builds with the `panic-test` feature.
+/// Panics on purpose, so tests can show what a panic does: with
+/// `catch-panics` it returns `MPCA_STATUS_PANIC` instead of unwinding into
+/// C; otherwise the program aborts after one line on stderr. Only in builds
+/// with the `panic-test` feature.
 #[cfg(feature = "panic-test")]
 #[unsafe(no_mangle)]
 pub extern "C" fn mpca_debug_panic() -> mpca_status {

@@ -33,7 +33,7 @@ pub type mpca_run_tasks = Option<unsafe extern "C" fn(world: *mut mpca_world, ti
 ///
 /// A task the host did not run is run on this thread before the step ends,
 /// so a `run_tasks` that returns early still completes the step. Hosted
-/// builds only (the default `std` feature).
+/// builds only (the default `hosted` feature).
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_world_step_parallel(
     world: *mut mpca_world,

@@ -18,7 +18,8 @@ pub enum mpca_status {
     /// created, or the wrong kind of memory.
     BadHandle = 2,
     /// The library panicked (a bug in mpca); the world may be inconsistent
-    /// and should be destroyed.
+    /// and should be destroyed. Only a library built with the feature
+    /// `catch-panics` returns it: the default one aborts instead.
     Panic = 3,
     /// A structure's `struct_size` does not match this library's.
     BadStructSize = 4,

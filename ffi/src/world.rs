@@ -9,9 +9,9 @@ use crate::{check_size, guard, handle, mpca_desc, mpca_status};
 /// back to this library, never dereferenced. (Not `repr(C)`, so cbindgen
 /// declares it as an incomplete type.)
 ///
-/// Hosted builds (the default, with `std`): a handle is a value the library
-/// issues, not the world's address, and no value is issued twice in a
-/// process. The library keeps a registry of the live ones and asks it before
+/// Hosted builds (the default, feature `hosted`): a handle is a value the
+/// library issues, not the world's address, and no value is issued twice in
+/// a process. The library keeps a registry of the live ones and asks it before
 /// it reads any memory, so every value that is not the handle of a live
 /// world is refused with `MPCA_STATUS_BAD_HANDLE` (NULL with
 /// `MPCA_STATUS_NULL_POINTER`) without a read: the handle of a destroyed or
@@ -23,7 +23,7 @@ use crate::{check_size, guard, handle, mpca_desc, mpca_status};
 /// worlds in a process; create and init then return
 /// `MPCA_STATUS_OUT_OF_MEMORY`.
 ///
-/// Firmware builds (without `std`: no allocator, no registry): the handle
+/// Firmware builds (without `hosted`: no allocator, no registry): the handle
 /// is the world's address in the caller's memory, and the world's header
 /// holds a tag tied to that address, which mpca_world_deinit clears.
 /// Promised: NULL, and a value not aligned as a world's start, are refused
@@ -85,9 +85,9 @@ pub unsafe extern "C" fn mpca_world_deinit(world: *mut mpca_world) -> mpca_statu
 }
 
 /// Allocates and builds an empty world; mpca_world_destroy frees it.
-/// Hosted builds only (the default `std` feature): firmware builds have
+/// Hosted builds only (the default `hosted` feature): firmware builds have
 /// neither this nor mpca_world_destroy.
-#[cfg(feature = "std")]
+#[cfg(feature = "hosted")]
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_world_create(desc: *const mpca_desc, out_world: *mut *mut mpca_world) -> mpca_status {
     guard(|c| {
@@ -104,7 +104,7 @@ pub unsafe extern "C" fn mpca_world_create(desc: *const mpca_desc, out_world: *m
 /// Frees a world made by mpca_world_create. NULL is accepted and does
 /// nothing. A destroyed handle, a world in caller memory
 /// (`MPCA_STATUS_NOT_OWNED`) or anything else is refused.
-#[cfg(feature = "std")]
+#[cfg(feature = "hosted")]
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_world_destroy(world: *mut mpca_world) -> mpca_status {
     guard(|_| {

@@ -7,7 +7,7 @@
  * every cell and surface entry read back) is taken before and after the call.
  * Out-parameters of refused calls are checked to be untouched.
  *
- * Also: the structure layouts, every status message, the panic boundary.
+ * Also: the structure layouts and every status message (panics: panic.c).
  * Prints "error cases: N"; tests/tests/c_abi.rs checks N against a minimum.
  */
 #include <math.h>
@@ -1165,7 +1165,7 @@ static void output_cases(void) {
     }
 }
 
-/* --- Messages, version, panics ----------------------------------------- */
+/* --- Messages, version ------------------------------------------------ */
 
 #define STATUS(name) {#name, name}
 static const struct {
@@ -1263,23 +1263,6 @@ static void message_cases(void) {
     printf("version: %s\n", version != NULL ? version : "(null)");
 }
 
-/* A panic inside the library comes back as a status; the program and the
- * library go on. */
-static void panic_case(void) {
-    set_context("panic boundary");
-    uint64_t before = fingerprint();
-    mpca_status st = TRACE(mpca_debug_panic());
-    CHECK(st == MPCA_STATUS_PANIC);
-    printf("panic: mpca_debug_panic returned %u and the program goes on\n", (unsigned)st);
-    CHECK(fingerprint() == before);
-    st = TRACE(mpca_debug_panic());
-    CHECK(st == MPCA_STATUS_PANIC);
-    uint64_t hash = 0;
-    CHECK_OK(mpca_world_hash(full2, &hash));
-    CHECK_OK(mpca_world_step(full2, 1));
-    printf("after panic: the library still steps worlds\n");
-}
-
 /* The success paths that the error cases above do not reach. */
 static void success_cases(void) {
     set_context("success paths");
@@ -1324,7 +1307,6 @@ int main(void) {
     output_cases();
     handle_cases();
     message_cases();
-    panic_case();
     success_cases();
 
     set_context("teardown");

@@ -3,7 +3,11 @@
 //! checked here.
 //!
 //! - `errors.c` (linked statically): structure layouts, every error path,
-//!   every status message, the panic boundary; prints `error cases: N`.
+//!   every status message; prints `error cases: N`.
+//! - `panic.c`: a panic inside the library, linked statically with the
+//!   library built with `catch-panics` (the call returns a status and the
+//!   program goes on) and dynamically with the shipped one (the program
+//!   aborts with one line on stderr).
 //! - `scenes.c` (linked dynamically): a 2D and a 3D scene stepped from C,
 //!   whose hashes and statistics must equal those of the same scenes built
 //!   here through the Rust API; the exports against the cells.
@@ -33,7 +37,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::OnceLock;
 
-use clib::{library, root};
+use clib::{catching_library, library, root};
 
 use mpca::{Boundary, Collisions, Description, Drift, Emitter, Method, Quantization, Shape, Stats, World, WorldBox};
 
@@ -106,9 +110,14 @@ fn command_line(cmd: &Command) -> String {
     std::iter::once(cmd.get_program()).chain(cmd.get_args()).map(|a| a.to_string_lossy()).collect::<Vec<_>>().join(" ")
 }
 
-/// Compiles and links `tests/c/<sources>` into `<name>`.
+/// Compiles and links `tests/c/<sources>` into `<name>`, with the shipped
+/// library.
 fn build(name: &str, sources: &[&str], link: Link) -> PathBuf {
-    let lib = library();
+    build_with(library(), name, sources, link)
+}
+
+/// As [`build`], with the libraries in `lib`.
+fn build_with(lib: &Path, name: &str, sources: &[&str], link: Link) -> PathBuf {
     let exe = out_dir().join(name);
     let mut cmd = compiler(false, true);
     cmd.arg("-o").arg(&exe);
@@ -139,6 +148,8 @@ struct Run {
     exe: PathBuf,
     ok: bool,
     status: String,
+    /// The signal that ended the program, if one did.
+    signal: Option<i32>,
     stdout: String,
     stderr: String,
 }
@@ -214,6 +225,7 @@ fn run(exe: PathBuf, asan_options: &str) -> Run {
         exe,
         ok: out.status.success(),
         status: out.status.to_string(),
+        signal: std::os::unix::process::ExitStatusExt::signal(&out.status),
         stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
         stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
     };
@@ -256,6 +268,18 @@ fn edges() -> &'static Run {
 fn parallel() -> &'static Run {
     static RUN: OnceLock<Run> = OnceLock::new();
     RUN.get_or_init(|| run(build("parallel", &["parallel.c", "check.c"], Link::Static), ""))
+}
+
+/// `panic.c` with the library built with catch-panics (static), and with
+/// the shipped one (shared, as a C program loads it).
+fn panic_catching() -> &'static Run {
+    static RUN: OnceLock<Run> = OnceLock::new();
+    RUN.get_or_init(|| run(build_with(catching_library(), "panic-catching", &["panic.c", "check.c"], Link::Static), ""))
+}
+
+fn panic_aborting() -> &'static Run {
+    static RUN: OnceLock<Run> = OnceLock::new();
+    RUN.get_or_init(|| run(build("panic-aborting", &["panic.c", "check.c"], Link::Shared), ""))
 }
 
 fn snapshots() -> &'static Run {
@@ -470,6 +494,14 @@ fn the_shared_library_carries_its_soname() {
     assert_eq!(soname.as_deref(), Some(clib::soname()), "the SONAME of libmpca.so");
 }
 
+/// What README.md says libmpca.so needs at run time: the C library and
+/// nothing else (no Rust std, so no libgcc_s for unwinding; ffi/src/sys.rs).
+#[test]
+fn the_shared_library_needs_only_the_c_library() {
+    let needed = Elf::read(&library().join("libmpca.so")).needed();
+    assert!(needed.len() == 1 && needed[0].starts_with("libc.so"), "libmpca.so needs {needed:?}");
+}
+
 #[test]
 fn shared_library_exports_exactly_the_header_functions() {
     let exported: BTreeSet<String> = Elf::read(&library().join("libmpca.so"))
@@ -491,7 +523,9 @@ fn every_header_function_is_in_the_c_symbol_table_and_called_from_c() {
         assert_eq!(table, header, "{}: the symbol table of tests/c/check.c against the header", run.name());
         called.extend(run.values("called: ").into_iter().map(String::from));
     }
-    called.extend(parallel().values("called: ").into_iter().map(String::from));
+    for run in [parallel(), panic_catching()] {
+        called.extend(run.values("called: ").into_iter().map(String::from));
+    }
     let never: Vec<_> = header.difference(&called).collect();
     assert!(never.is_empty(), "functions no C program calls: {never:?}");
 }
@@ -525,12 +559,33 @@ fn every_status_of_the_header_has_a_message() {
     run.assert_no_failures_in("status messages");
 }
 
+/// Built with catch-panics, the library returns a panic as a status and
+/// goes on.
 #[test]
 fn a_panic_inside_the_library_comes_back_to_c_as_a_status() {
-    let run = errors();
+    let run = panic_catching();
     assert_eq!(run.value("panic: "), "mpca_debug_panic returned 3 and the program goes on");
     run.value("after panic: ");
-    run.assert_no_failures_in("panic boundary");
+    run.assert_no_failures_in("panic");
+    run.assert_success();
+}
+
+/// The shipped library (no catch-panics) aborts on a panic, as a C library
+/// whose assert fails: one line on stderr naming where it panicked and
+/// why, SIGABRT, and nothing after the call.
+#[test]
+fn a_panic_in_the_shipped_library_aborts_with_one_line_on_stderr() {
+    let run = panic_aborting();
+    run.value("before panic: ");
+    assert!(run.values("panic: ").is_empty() && run.values("after panic: ").is_empty(), "the call returned:\n{}", run.stdout);
+    assert_eq!(run.signal, Some(6), "{} ended with {}, not SIGABRT", run.name(), run.status);
+    let lines: Vec<&str> = run.stderr.lines().filter(|l| l.starts_with("mpca: ")).collect();
+    assert_eq!(lines.len(), 1, "stderr:\n{}", run.stderr);
+    let line = lines[0];
+    assert!(
+        line.starts_with("mpca: panicked at ffi/src/lib.rs:") && line.ends_with(": mpca_debug_panic was called"),
+        "the panic's line: {line}"
+    );
 }
 
 // --- Scenes --------------------------------------------------------------------

@@ -1,0 +1,230 @@
+//! What a hosted library without Rust's `std` takes from the C library it
+//! is loaded with: memory (`malloc`, `calloc`, `free`, `posix_memalign`),
+//! a lock for the registry of handles (core's atomics, waiting with
+//! `sched_yield`), and, for a panic, one line on stderr (`write`) and
+//! `abort`. These are the only C functions libmpca calls (`readelf -d`
+//! shows `libc.so.6` as its one dependency).
+//!
+//! Why not `std`: linking it brings its panic machinery (the default hook,
+//! backtraces, symbol demangling, DWARF parsing): 288 KB of the stripped
+//! shared library on x86-64 Linux (669,760 bytes with `std` and panic =
+//! "abort", 382,120 without), for a panic that is a bug and should end the
+//! program anyway; and it needs GCC's unwinder, `libgcc_s`, at run time.
+//! The feature `catch-panics` builds with `std` and its panic boundary
+//! instead (lib.rs).
+
+use core::cell::UnsafeCell;
+use core::ffi::{c_int, c_void};
+use core::ops::{Deref, DerefMut};
+use core::sync::atomic::{AtomicBool, Ordering};
+
+// `link`: so that libmpca.so names libc.so.6 as needed, and rustc lists
+// -lc among the libraries a static link needs. (Elsewhere, Windows say,
+// the C runtime is linked anyway.)
+#[cfg_attr(unix, link(name = "c"))]
+unsafe extern "C" {
+    fn malloc(size: usize) -> *mut c_void;
+    fn calloc(count: usize, size: usize) -> *mut c_void;
+    fn free(p: *mut c_void);
+    #[cfg(unix)]
+    fn posix_memalign(out: *mut *mut c_void, align: usize, size: usize) -> c_int;
+    #[cfg(all(unix, not(any(test, feature = "catch-panics"))))]
+    fn write(fd: c_int, buf: *const c_void, count: usize) -> isize;
+    #[cfg(not(any(test, feature = "catch-panics")))]
+    fn abort() -> !;
+    #[cfg(unix)]
+    fn sched_yield() -> c_int;
+}
+
+/// Rust's global allocator in hosted builds: the C library's `malloc`
+/// family, so the memory of a world from mpca_world_create is counted,
+/// traced and limited as the program's own.
+pub(crate) struct CAllocator;
+
+/// The alignment `malloc` guarantees (that of `max_align_t`: 16 on 64-bit
+/// targets, 8 on 32-bit ones, as `std`'s allocator assumes too). A
+/// request for more goes through `posix_memalign`.
+const MALLOC_ALIGN: usize = if usize::BITS >= 64 { 16 } else { 8 };
+
+impl CAllocator {
+    /// Whether plain `malloc` meets `layout`'s alignment: C promises its
+    /// fundamental alignment only for blocks at least that large.
+    fn plain(layout: core::alloc::Layout) -> bool {
+        layout.align() <= MALLOC_ALIGN && layout.align() <= layout.size()
+    }
+
+    /// An over-aligned block, or NULL.
+    fn aligned(layout: core::alloc::Layout) -> *mut u8 {
+        #[cfg(unix)]
+        {
+            let mut p = core::ptr::null_mut();
+            // posix_memalign asks for a multiple of the pointer's size.
+            let align = layout.align().max(size_of::<usize>());
+            // SAFETY: `p` is a valid out-parameter; `align` is a power of
+            // two (Layout's) and a multiple of sizeof(void *).
+            if unsafe { posix_memalign(&mut p, align, layout.size()) } == 0 { p.cast() } else { core::ptr::null_mut() }
+        }
+        // No portable C function: no request of this library is aligned
+        // beyond malloc's (a world's header asks for 8).
+        #[cfg(not(unix))]
+        {
+            let _ = layout;
+            core::ptr::null_mut()
+        }
+    }
+}
+
+// SAFETY: every block comes from malloc, calloc or posix_memalign, aligned
+// as asked (`plain`, or posix_memalign's own promise), at least as large,
+// and is given back to free, which takes each of them.
+unsafe impl core::alloc::GlobalAlloc for CAllocator {
+    unsafe fn alloc(&self, layout: core::alloc::Layout) -> *mut u8 {
+        // SAFETY: malloc accepts any size.
+        if Self::plain(layout) { unsafe { malloc(layout.size()).cast() } } else { Self::aligned(layout) }
+    }
+
+    unsafe fn alloc_zeroed(&self, layout: core::alloc::Layout) -> *mut u8 {
+        if Self::plain(layout) {
+            // calloc: a large world's zeroed pages come from the system
+            // untouched instead of being written.
+            // SAFETY: calloc accepts any size.
+            unsafe { calloc(layout.size(), 1).cast() }
+        } else {
+            let p = Self::aligned(layout);
+            if !p.is_null() {
+                // SAFETY: `p` is a fresh block of layout.size() bytes.
+                unsafe { p.write_bytes(0, layout.size()) };
+            }
+            p
+        }
+    }
+
+    unsafe fn dealloc(&self, p: *mut u8, _: core::alloc::Layout) {
+        // SAFETY: `p` came from this allocator (GlobalAlloc's contract).
+        unsafe { free(p.cast()) }
+    }
+}
+
+/// Gives the processor to another thread, where the system has a call for it.
+pub(crate) fn yield_now() {
+    #[cfg(unix)]
+    // SAFETY: sched_yield takes nothing and cannot fail in a way that matters.
+    unsafe {
+        sched_yield();
+    }
+    #[cfg(not(unix))]
+    core::hint::spin_loop();
+}
+
+/// A lock on core's atomics: what the registry of handles needs from
+/// `std::sync::Mutex` (every hold is a few map operations long), without
+/// `std`. A waiting thread spins briefly, then yields.
+pub(crate) struct Lock<T> {
+    held: AtomicBool,
+    value: UnsafeCell<T>,
+}
+
+// SAFETY: the value is reached only through a `Held`, and one `Held` at a
+// time exists (the flag, taken with Acquire and released with Release,
+// orders each holder's accesses after the previous holder's).
+unsafe impl<T: Send> Sync for Lock<T> {}
+
+impl<T> Lock<T> {
+    pub(crate) const fn new(value: T) -> Lock<T> {
+        Lock { held: AtomicBool::new(false), value: UnsafeCell::new(value) }
+    }
+
+    /// Waits until the lock is free and takes it; the returned guard frees
+    /// it when dropped, also when a panic unwinds (catch-panics builds).
+    pub(crate) fn lock(&self) -> Held<'_, T> {
+        let mut waited = 0u32;
+        while self.held.compare_exchange_weak(false, true, Ordering::Acquire, Ordering::Relaxed).is_err() {
+            while self.held.load(Ordering::Relaxed) {
+                waited = waited.saturating_add(1);
+                if waited < 64 { core::hint::spin_loop() } else { yield_now() }
+            }
+        }
+        Held { lock: self }
+    }
+}
+
+/// The value of a [`Lock`] while held.
+pub(crate) struct Held<'a, T> {
+    lock: &'a Lock<T>,
+}
+
+impl<T> Deref for Held<'_, T> {
+    type Target = T;
+    fn deref(&self) -> &T {
+        // SAFETY: this guard holds the lock: no other reference exists.
+        unsafe { &*self.lock.value.get() }
+    }
+}
+
+impl<T> DerefMut for Held<'_, T> {
+    fn deref_mut(&mut self) -> &mut T {
+        // SAFETY: as in deref, and `&mut self` makes this the only one.
+        unsafe { &mut *self.lock.value.get() }
+    }
+}
+
+impl<T> Drop for Held<'_, T> {
+    fn drop(&mut self) {
+        self.lock.held.store(false, Ordering::Release);
+    }
+}
+
+/// A panic in a library without `std` (lib.rs says why it is not caught):
+/// one line on stderr, `mpca: panicked at FILE:LINE:COLUMN: MESSAGE`, cut
+/// at 255 bytes, then `abort()`, as a C library's failed `assert` does.
+#[cfg(not(any(test, feature = "catch-panics")))]
+pub(crate) fn die(info: &core::panic::PanicInfo<'_>) -> ! {
+    /// The line, built in place: one `write`, so that lines of threads
+    /// that panic together do not interleave.
+    struct Line {
+        bytes: [u8; 256],
+        len: usize,
+    }
+    impl core::fmt::Write for Line {
+        fn write_str(&mut self, s: &str) -> core::fmt::Result {
+            let room = self.bytes.len() - 1 - self.len;
+            let take = s.len().min(room);
+            self.bytes[self.len..self.len + take].copy_from_slice(&s.as_bytes()[..take]);
+            self.len += take;
+            Ok(())
+        }
+    }
+    // A second panic (in the formatting below, or on another thread
+    // meanwhile) aborts at once.
+    static PANICKED: AtomicBool = AtomicBool::new(false);
+    if PANICKED.swap(true, Ordering::Relaxed) {
+        // SAFETY: abort takes nothing and does not return.
+        unsafe { abort() }
+    }
+    let mut line = Line { bytes: [0; 256], len: 0 };
+    let _ = match info.location() {
+        Some(at) => core::fmt::write(&mut line, format_args!("mpca: panicked at {at}: {}", info.message())),
+        None => core::fmt::write(&mut line, format_args!("mpca: panicked: {}", info.message())),
+    };
+    line.bytes[line.len] = b'\n';
+    #[cfg(unix)]
+    // SAFETY: the first len + 1 bytes of `line.bytes` are initialised.
+    unsafe {
+        write(2, line.bytes.as_ptr().cast(), line.len + 1);
+    }
+    // SAFETY: abort takes nothing and does not return.
+    unsafe { abort() }
+}
+
+/// The personality routine that the unwind tables of Rust's precompiled
+/// `core` and `compiler_builtins` name: they are built to unwind, and `std`,
+/// which defines it, is not linked, so without this the link of a program
+/// against a debug build (any build on 32-bit Arm) fails on an undefined
+/// `rust_eh_personality` (rust-lang/rust#106864). Never called: nothing in
+/// this library unwinds (panic = "abort"); were it called, it answers
+/// `_URC_FAILURE`, so an unwinder stops instead of passing through.
+#[cfg(not(any(test, feature = "catch-panics")))]
+#[unsafe(no_mangle)]
+extern "C" fn rust_eh_personality() -> c_int {
+    9
+}
