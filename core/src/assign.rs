@@ -109,23 +109,65 @@ pub fn cost(problem: &MoveProblem, assignment: &Assignment) -> (u32, u32) {
 /// cells distinct, free and inside the block, desired cells inside the
 /// block) are checked in debug builds only. A release build given a block
 /// with more particles than free cells leaves every particle where it is.
+///
+/// Inlined: the step settles a 2D block's exact-fast assignment from the
+/// table before it calls this, so where this is inlined into the step the
+/// compiler sees that the 2D table's method is not called from there, and
+/// a 2D-only firmware does not carry it (the fallback for keys the table
+/// does not list is most of it).
+#[inline(always)]
 pub fn assign_moves<const D: usize>(method: Method, problem: &MoveProblem, rng: &mut Stream) -> Assignment {
     const { assert!(D == 2 || D == 3, "a Margolus block has 2 or 3 axes") };
-    let cells = 1usize << D;
-    let free = problem.free & block_mask(cells);
-    let count = problem.count.min(MAX_CELLS);
-    debug_assert!(well_formed(problem, cells), "malformed block: {problem:?}");
+    // The step's own test, `method == Method::ExactFast`, in the same
+    // words: the compiler knows its answer here without following `method`
+    // through the step's loops, which it does not do (a `match` on
+    // `method` kept the call in the firmware).
+    if D == 2 && method == Method::ExactFast {
+        return exact_fast_2d(problem, rng);
+    }
+    solve::<D>(method, problem, rng)
+}
+
+/// [`Method::ExactFast`] in 2D.
+fn exact_fast_2d(problem: &MoveProblem, rng: &mut Stream) -> Assignment {
+    let (free, count) = block::<2>(problem);
     if count > free.count_ones() as usize {
-        let mut stay = Assignment::default();
-        stay.target[..count].copy_from_slice(&problem.current[..count]);
-        return stay;
+        return stay(problem, count);
+    }
+    exact_table_2d(problem, free, count, rng)
+}
+
+/// Every method but 2D exact-fast, which [`assign_moves`] takes to the
+/// table.
+fn solve<const D: usize>(method: Method, problem: &MoveProblem, rng: &mut Stream) -> Assignment {
+    let (free, count) = block::<D>(problem);
+    if count > free.count_ones() as usize {
+        return stay(problem, count);
     }
     match method {
-        Method::Exhaustive => exhaustive(problem, free, count, rng),
-        Method::ExactFast if D == 2 => exact_table_2d(problem, free, count, rng),
-        Method::ExactFast => exact_3d(problem, free, count, |ways| rng.below(ways)),
+        Method::ExactFast if D == 3 => exact_3d(problem, free, count, |ways| rng.below(ways)),
+        // 2D exact-fast never comes here; were it to, exhaustive search
+        // reaches the same optimum.
+        Method::Exhaustive | Method::ExactFast => exhaustive(problem, free, count, rng),
         Method::Greedy => greedy(problem, free, count, rng),
     }
+}
+
+/// The free cells of the block and its number of particles, the
+/// preconditions checked in debug builds.
+#[inline]
+fn block<const D: usize>(problem: &MoveProblem) -> (u8, usize) {
+    let cells = 1usize << D;
+    debug_assert!(well_formed(problem, cells), "malformed block: {problem:?}");
+    (problem.free & block_mask(cells), problem.count.min(MAX_CELLS))
+}
+
+/// Everyone where they are: the answer to a block with more particles
+/// than free cells (a broken precondition, caught in debug builds).
+fn stay(problem: &MoveProblem, count: usize) -> Assignment {
+    let mut stay = Assignment::default();
+    stay.target[..count].copy_from_slice(&problem.current[..count]);
+    stay
 }
 
 /// Number of axes on which two local cells (below 8) differ (M5.6): the
