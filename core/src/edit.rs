@@ -93,14 +93,30 @@ impl World {
         crate::desc::mass(m)?;
         // Last fallible step; it changes the world only when it succeeds.
         let index = self.mass_index_of(m)?;
-        self.place(s, v, index, 0, None);
+        self.place_added(s, v, index);
         self.head.counters.particles += 1;
         Ok(())
     }
 
+    /// Writes an emitted particle into a free cell, its components rounded
+    /// stochastically from `rng` (M1). Not inlined into the step, whose
+    /// frame would grow by it (64 bytes of a Cortex-M4F's stack).
+    #[inline(never)]
+    pub(crate) fn place_emitted(&mut self, s: Site, v: [f32; 3], mass_index: u8, life: u16, rng: &mut crate::rng::Stream) {
+        self.place(s, v, mass_index, life, Some(rng));
+    }
+
+    /// Writes a particle a caller adds into a free cell, its components
+    /// rounded to nearest. Apart from [`World::place_emitted`], so that a
+    /// firmware that only emits does not carry this rounding.
+    fn place_added(&mut self, s: Site, v: [f32; 3], mass_index: u8) {
+        self.place(s, v, mass_index, 0, None);
+    }
+
     /// Writes a particle into a free cell. Components are rounded
     /// stochastically from `stream` when one is given (M1), else to nearest.
-    pub(crate) fn place(&mut self, s: Site, v: [f32; 3], mass_index: u8, life: u16, stream: Option<&mut crate::rng::Stream>) {
+    #[inline(always)]
+    fn place(&mut self, s: Site, v: [f32; 3], mass_index: u8, life: u16, stream: Option<&mut crate::rng::Stream>) {
         let d = self.dim();
         let summary_words = self.layout().summary_words;
         let per_mass = self.head.desc.per_particle_mass;

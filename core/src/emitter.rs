@@ -219,7 +219,7 @@ impl World {
                 if take {
                     need -= 1;
                     let v = spread_velocity(&e, dim, &mut rng);
-                    w.place(s, v, slot.mass_index as u8, e.lifetime as u16, Some(&mut rng));
+                    w.place_emitted(s, v, slot.mass_index as u8, e.lifetime as u16, &mut rng);
                 }
             };
             each_site(&l, &e, |s| chosen(self, s));
