@@ -802,10 +802,7 @@ impl Prices {
         // above), so the lanes add without carrying into each other, and
         // the cells at the price are the lanes where the sum xor it is 0.
         let sums = wide(costs) + wide(&self.lift);
-        // The price in every lane, by shifts (no wide multiply on small cores).
-        let at_price = u128::from(price as u16) << 16 | u128::from(price as u16);
-        let at_price = at_price << 32 | at_price;
-        zero_lanes(sums ^ (at_price << 64 | at_price))
+        zero_lanes(sums ^ (u128::from(price as u16) * EACH_LANE))
     }
 
     /// The cells every optimal assignment fills: those with lift.
