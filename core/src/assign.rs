@@ -497,29 +497,23 @@ const NONE: u8 = u8::MAX;
 /// only where there are `n > 1` optimal assignments.
 ///
 /// 1. Every particle alone in wanting a free cell: each gets it, the only
-///    assignment with cost1 = 0. Looked for in blocks of up to six
-///    particles only: with seven or eight, all wishes differ in 2 % or
-///    0.2 % of random blocks, and step 3 reaches the same assignment
-///    without a draw (its start places everyone, and each placed particle
-///    has one tight cell).
+///    assignment with cost1 = 0.
 /// 2. One or two particles: counted directly.
 /// 3. Otherwise the Hungarian method finds one optimal assignment and
 ///    prices that tell which (particle, cell) pairs any optimal assignment
 ///    may use; see [`pick`] for how those are counted and drawn from.
 fn exact_3d(problem: &MoveProblem, free: u8, count: usize, draw: impl FnOnce(u32) -> u32) -> Assignment {
-    if count <= 6 {
-        let mut wanted = 0u8;
-        let mut clash = 0u8;
-        for &want in &problem.desired[..count] {
-            let bit = 1 << (want & 7);
-            clash |= wanted & bit;
-            wanted |= bit;
-        }
-        if clash == 0 && wanted & !free == 0 {
-            let mut assignment = Assignment::default();
-            assignment.target[..count].copy_from_slice(&problem.desired[..count]);
-            return assignment;
-        }
+    let mut wanted = 0u8;
+    let mut clash = 0u8;
+    for &want in &problem.desired[..count] {
+        let bit = 1 << (want & 7);
+        clash |= wanted & bit;
+        wanted |= bit;
+    }
+    if clash == 0 && wanted & !free == 0 {
+        let mut assignment = Assignment::default();
+        assignment.target[..count].copy_from_slice(&problem.desired[..count]);
+        return assignment;
     }
     if count <= 2 {
         return few(problem, free, count, draw);
@@ -743,13 +737,11 @@ impl Prices {
             let mut key = [0; MAX_CELLS];
             for t in 0..MAX_CELLS {
                 let d = offset + costs[t] + self.bias[t];
-                via[t] = if d < reach[t] { from } else { via[t] };
-                reach[t] = reach[t].min(d);
-                // An open cell's distance is below 2^12 (a cost, a lift and
-                // a price of at most a few hundred each), so its rank is
-                // positive; a settled or shut cell (closed -1) ranks last.
-                let ranked = reach[t] << 3 | t as i16;
-                key[t] = ranked.max(closed[t] & i16::MAX);
+                let nearer = d < reach[t];
+                reach[t] = if nearer { d } else { reach[t] };
+                via[t] = if nearer { from } else { via[t] };
+                let ranked = reach[t].wrapping_shl(3) | t as i16;
+                key[t] = if closed[t] == 0 { ranked } else { i16::MAX };
             }
             let least = min_lane(&key);
             let (next, best) = (usize::from(least as u8 & 7), least >> 3);
@@ -798,17 +790,20 @@ impl Prices {
         if price < i16::from(PRIMARY) {
             return 1 << at;
         }
-        // Every cost and lift lies in [0, 2^14) (see SHUT and the bounds
-        // above), so the lanes add without carrying into each other, and
-        // the cells at the price are the lanes where the sum xor it is 0.
-        let sums = wide(costs) + wide(&self.lift);
-        zero_lanes(sums ^ (u128::from(price as u16) * EACH_LANE))
+        let mut bytes = [0u8; MAX_CELLS];
+        for ((byte, &cost), &lift) in bytes.iter_mut().zip(costs).zip(&self.lift) {
+            *byte = u8::from(cost + lift == price);
+        }
+        gather(bytes)
     }
 
     /// The cells every optimal assignment fills: those with lift.
     fn must(&self) -> u8 {
-        // Lifts are never negative.
-        !zero_lanes(wide(&self.lift))
+        let mut bytes = [0u8; MAX_CELLS];
+        for (byte, &lift) in bytes.iter_mut().zip(&self.lift) {
+            *byte = u8::from(lift > 0);
+        }
+        gather(bytes)
     }
 }
 
@@ -822,32 +817,12 @@ fn min_lane(lanes: &Lanes) -> i16 {
     half[0].min(half[2]).min(half[1].min(half[3]))
 }
 
-/// 1 in each 16-bit lane of a [`wide`] value.
-const EACH_LANE: u128 = u128::MAX / 0xffff;
-
-/// The eight lanes as one integer, lane `t` in bits `16t..16t + 16`.
+/// Bit `t` set where byte `t` is 1 (all bytes 0 or 1): the multiply moves
+/// byte t's bit to bit 56 + t, and no two partial products meet below bit
+/// 64 in a way that carries into those eight.
 #[inline]
-fn wide(lanes: &Lanes) -> u128 {
-    let mut bytes = [0u8; 2 * MAX_CELLS];
-    for (pair, lane) in bytes.chunks_exact_mut(2).zip(lanes) {
-        pair.copy_from_slice(&lane.to_le_bytes());
-    }
-    u128::from_le_bytes(bytes)
-}
-
-/// Bit `t` set where lane `t` of `x` is 0, every lane being below 2^15:
-/// adding 0x7fff to a lane sets its top bit exactly when it is not 0,
-/// without a carry out of it. Then, per half of four lanes, the multiply
-/// moves lane t's top bit (shifted to 16t) to bit 48 + t; its other partial
-/// products land on distinct bits below 36 or at 64 and beyond, so none
-/// carries into those four.
-#[inline]
-fn zero_lanes(x: u128) -> u8 {
-    const TOP: u128 = 0x8000 * EACH_LANE;
-    const SPREAD: u64 = 1 << 48 | 1 << 33 | 1 << 18 | 1 << 3;
-    let zero = !(x + 0x7fff * EACH_LANE) & TOP;
-    let half = |h: u64| ((h >> 15).wrapping_mul(SPREAD) >> 48) as u8 & 15;
-    half(zero as u64) | half((zero >> 64) as u64) << 4
+fn gather(bytes: [u8; MAX_CELLS]) -> u8 {
+    (u64::from_le_bytes(bytes).wrapping_mul(0x0102_0408_1020_4080) >> 56) as u8
 }
 
 /// One optimal assignment, uniformly, from the placed prices.
@@ -996,7 +971,6 @@ impl Ways {
 impl Group {
     /// Lists `members` with their choices, those with two first: the sets
     /// of cells the first members can take then stay few.
-    #[inline]
     fn fill(&mut self, tight: &[u8; MAX_CELLS], members: u8) {
         let mut pair = 0u8;
         for i in bits(members) {
@@ -1012,7 +986,6 @@ impl Group {
 
     /// Fills `table` for this group a member at a time, from the sets the
     /// members before reach, then keeps the final sets that hold `must`.
-    #[inline]
     fn count(&mut self, must: u8, table: &mut Ways) {
         let (mut a, mut b) = ([0u8; MAX_ENDS], [0u8; MAX_ENDS]);
         let (mut sets, mut next) = (&mut a, &mut b);
@@ -1050,7 +1023,6 @@ impl Group {
     /// The way of rank `rank` (below `ways`): the final set whose ways reach
     /// past the rank, then, last member first, the cell whose removal leaves
     /// a set with ways reaching past what is left of it.
-    #[inline]
     fn nth(&self, mut rank: u32, table: &Ways) -> [u8; MAX_CELLS] {
         let mut chosen = [0u8; MAX_CELLS];
         let mut used = 0u8;
@@ -1677,25 +1649,6 @@ mod tests {
             }
         }
         problem
-    }
-
-    #[test]
-    fn zero_lanes_finds_every_zero_lane() {
-        // Expect: bit t set exactly where lane t is 0, for lanes below 2^15
-        // (every value up to 0x7fff in some lane, zeros anywhere).
-        let mut rng = block_stream(4, 0, 0);
-        for round in 0..crate::sized(20_000, 300) {
-            let mut lanes: Lanes = [0; MAX_CELLS];
-            for lane in lanes.iter_mut() {
-                let r = rng.next_u64();
-                *lane = if r & 3 == 0 { 0 } else { (r >> 8) as i16 & 0x7fff };
-            }
-            if round < 0x8000 {
-                lanes[round % MAX_CELLS] = round as i16;
-            }
-            let want = (0..MAX_CELLS).fold(0u8, |m, t| m | u8::from(lanes[t] == 0) << t);
-            assert_eq!(zero_lanes(wide(&lanes)), want, "{lanes:?}");
-        }
     }
 
     #[test]
