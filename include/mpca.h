@@ -662,8 +662,8 @@ typedef struct mpca_emitter {
   float velocity[3];
   /**
    * Radius of a uniform random spread added to the velocity;
-   * |velocity| + spread <= 1 (summed in double precision, so a sum above
-   * 1 by more than about 1e-16 is refused).
+   * |velocity| + spread <= 1, decided exactly (no rounding: a sum above 1
+   * by any amount is refused).
    */
   float spread;
   /**

@@ -19,8 +19,8 @@ pub struct mpca_emitter {
     /// Initial velocity.
     pub velocity: [f32; 3],
     /// Radius of a uniform random spread added to the velocity;
-    /// |velocity| + spread <= 1 (summed in double precision, so a sum above
-    /// 1 by more than about 1e-16 is refused).
+    /// |velocity| + spread <= 1, decided exactly (no rounding: a sum above 1
+    /// by any amount is refused).
     pub spread: f32,
     /// Mass of the emitted particles.
     pub mass: f32,
