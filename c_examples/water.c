@@ -42,25 +42,33 @@ static water_geometry geometry(uint32_t size) {
     return g;
 }
 
-#ifdef WATER_POOL
-static mpca_world *build(const scene_opts *o) {
-    const water_geometry g = geometry(o->size);
-    const float e = 0.5f;
+/* What both builds share: the box with walls, a uniform force, room for
+ * the sphere's surface and the seed. */
+static mpca_desc box_desc(const scene_opts *o) {
     mpca_desc d;
     mpca_check(mpca_desc_defaults(&d, 3, o->size, o->size, o->size), "mpca_desc_defaults");
     for (int axis = 0; axis < 3; axis++) {
         d.boundary[axis][0] = d.boundary[axis][1] = MPCA_BOUNDARY_WALL;
     }
-    d.restitution = e;
-    d.wall_restitution = e;
-    d.contacts = 1;
     d.forces = MPCA_FORCE_UNIFORM;
-    d.gravity[1] = -0.002f;
     d.obstacles = 1;
+    /* The sphere's surface grows with the square of the size. */
     float area = (float)o->size / PAPER_SIZE;
     area *= area;
     d.surface_capacity = area > 1.0f ? (uint32_t)ceilf(4096.0f * area) : 4096;
     d.seed = o->seed;
+    return d;
+}
+
+#ifdef WATER_POOL
+static mpca_world *build(const scene_opts *o) {
+    const water_geometry g = geometry(o->size);
+    const float e = 0.5f;
+    mpca_desc d = box_desc(o);
+    d.restitution = e;
+    d.wall_restitution = e;
+    d.contacts = 1;
+    d.gravity[1] = -0.002f;
     mpca_world *w = world_create(&d);
     mpca_check(mpca_world_add_sphere(w, g.centre, g.radius, e), "mpca_world_add_sphere");
     const uint32_t lo[3] = {20, 44, 20}, hi[3] = {44, 60, 44};
@@ -83,22 +91,11 @@ static mpca_world *build(const scene_opts *o) {
 #else
 static mpca_world *build(const scene_opts *o) {
     const water_geometry g = geometry(o->size);
-    mpca_desc d;
-    mpca_check(mpca_desc_defaults(&d, 3, o->size, o->size, o->size), "mpca_desc_defaults");
+    mpca_desc d = box_desc(o);
     d.drift = MPCA_DRIFT_PAPER; /* the paper's rule, as printed */
-    for (int axis = 0; axis < 3; axis++) {
-        d.boundary[axis][0] = d.boundary[axis][1] = MPCA_BOUNDARY_WALL;
-    }
     d.restitution = 1.0f;
-    d.forces = MPCA_FORCE_UNIFORM;
     d.gravity[1] = -0.02f;
-    d.obstacles = 1;
-    /* The sphere's surface grows with the square of the size. */
-    float area = (float)o->size / PAPER_SIZE;
-    area *= area;
-    d.surface_capacity = area > 1.0f ? (uint32_t)ceilf(4096.0f * area) : 4096;
     d.emitter_capacity = 1;
-    d.seed = o->seed;
     mpca_world *w = world_create(&d);
     mpca_check(mpca_world_add_sphere(w, g.centre, g.radius, 1.0f), "mpca_world_add_sphere");
     const mpca_emitter e = {
