@@ -127,6 +127,9 @@ pub(crate) struct Index<'a> {
 pub(crate) trait BlockSink<'a> {
     /// Cells of a block: 4 in 2D, 8 in 3D.
     const CELLS: usize;
+    /// The dimension, from `CELLS`: a constant, so that the sweep's loops
+    /// over a row's layers unroll and its cell masks fold.
+    const DIM: usize = if Self::CELLS == 8 { 3 } else { 2 };
     /// The planes the sweep reads and the summaries it keeps, read between
     /// visits.
     fn index(&self) -> Index<'a>;
@@ -238,9 +241,7 @@ impl Partition {
     pub fn sweep_band<'a, S: BlockSink<'a>>(&self, sink: &mut S, band: Range<usize>, reverse: bool, skip: bool) {
         let idx = sink.index();
         let [ax, ay, az] = self.axes;
-        // The dimension as a constant of the sink, so that the loops over a
-        // row's layers unroll and the cell masks fold.
-        let dim = if S::CELLS == 8 { 3 } else { 2 };
+        let dim = S::DIM;
         debug_assert_eq!(dim, self.dim);
         let layers = dim - 1;
         let total = band.len();
@@ -289,7 +290,7 @@ impl Partition {
     fn empty_run<'a, S: BlockSink<'a>>(&self, rows: Cells<'_, u8>, by: usize, bz: usize, reverse: bool, room: usize) -> usize {
         let [_, ay, az] = self.axes;
         let (zs, z_out) = self.axis_pair(2, az.first + 2 * bz as isize);
-        let layers = if S::CELLS == 8 { 2 } else { 1 };
+        let layers = S::DIM - 1;
         let mut run = 0;
         while run < 32 && run + 4 <= room {
             // The four rows of blocks from `low` to `low + 3`.
