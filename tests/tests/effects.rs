@@ -82,14 +82,16 @@ fn mean_speed(w: &World) -> f64 {
     w.particles().map(|p| f64::from(p.velocity.iter().map(|c| c * c).sum::<f32>()).sqrt()).sum::<f64>() / n
 }
 
-/// The pool after `steps`: mean speed and clamps per particle-step.
-fn poured(scene: &Scene, steps: u64) -> (f64, f64) {
+/// The pool after `steps`: mean speed, clamps per particle-step and the
+/// share of the particles below y = 10.
+fn poured(scene: &Scene, steps: u64) -> (f64, f64, f64) {
     let mut memory = Vec::new();
     let w = scenes::build(scene, &mut memory).unwrap();
     let n = w.particle_count();
     w.step(steps);
     assert_eq!(w.particle_count(), n, "nothing leaves a closed box");
-    (mean_speed(w), w.stats().clamps as f64 / (n * steps) as f64)
+    let low = w.particles().filter(|p| p.pos[1] < 10).count() as u64;
+    (mean_speed(w), w.stats().clamps as f64 / (n * steps) as f64, low as f64 / n as f64)
 }
 
 /// M5.7: under the paper's rules a particle pressing on a resting
@@ -105,8 +107,8 @@ fn poured(scene: &Scene, steps: u64) -> (f64, f64) {
 /// (docs/model.md, M5.7).
 #[test]
 fn contacts_let_a_pool_settle() {
-    let (paper_speed, paper_clamps) = poured(&pool(false, 0.01, 0.5), 1200);
-    let (speed, clamps) = poured(&pool(true, 0.01, 0.5), 1200);
+    let (paper_speed, paper_clamps, _) = poured(&pool(false, 0.01, 0.5), 1200);
+    let (speed, clamps, _) = poured(&pool(true, 0.01, 0.5), 1200);
     assert!(paper_clamps > 0.03, "{paper_clamps}");
     assert!(clamps <= 0.01, "clamps per particle-step {clamps}");
     assert!(speed < 0.6 * paper_speed, "mean |v| {speed} against the paper's {paper_speed}");
@@ -117,7 +119,7 @@ fn contacts_let_a_pool_settle() {
 /// clamp, as sqrt(h g) says: at g = 0.01 it stays near 0.12.
 #[test]
 fn a_pool_under_weak_gravity_comes_to_rest() {
-    let (speed, clamps) = poured(&pool(true, 0.001, 0.5), 2400);
+    let (speed, clamps, _) = poured(&pool(true, 0.001, 0.5), 2400);
     assert!(speed <= 0.05, "mean |v| {speed}");
     assert!(clamps <= 0.01, "clamps per particle-step {clamps}");
 }
@@ -131,22 +133,13 @@ fn a_pool_under_weak_gravity_comes_to_rest() {
 /// still bounces round the box: 29 % of it below y = 10, mean speed 0.43.
 #[test]
 fn poured_water_forms_a_pool_on_the_floor() {
-    let outcome = |scene: &Scene| {
-        let mut memory = Vec::new();
-        let w = scenes::build(scene, &mut memory).unwrap();
-        let n = w.particle_count();
-        w.step(scene.steps);
-        assert_eq!(w.particle_count(), n, "nothing leaves a closed box");
-        let low = w.particles().filter(|p| p.pos[1] < 10).count() as u64;
-        (low as f64 / n as f64, mean_speed(w), w.stats().clamps as f64 / (n * scene.steps) as f64)
-    };
     let scene = scenes::water_pool();
-    let (low, speed, clamps) = outcome(&scene);
+    let (speed, clamps, low) = poured(&scene, scene.steps);
     let mut paper = scene;
     paper.desc.contacts = false;
     paper.desc.restitution = 1.0;
     paper.desc.wall_restitution = 1.0;
-    let (paper_low, paper_speed, _) = outcome(&paper);
+    let (paper_speed, _, paper_low) = poured(&paper, paper.steps);
     assert_eq!(low, 1.0, "share of the water below y = 10");
     assert!(clamps <= 0.01, "clamps per particle-step {clamps}");
     assert!(speed < 0.1, "mean |v| {speed}");
