@@ -1,7 +1,7 @@
 //! Particle-particle collision (M5.2, eqs. 7-8).
 
 use crate::rng::Stream;
-use crate::vector::{dot, normalise};
+use crate::vector::{dot_of, normalise};
 
 /// Cell pairs of a block, in a fixed order: `PAIRS_2D` has the C(4,2) = 6
 /// pairs of a 2D block, `PAIRS_3D` the C(8,2) = 28 of a 3D one. M5.2 picks
@@ -95,7 +95,7 @@ pub(crate) fn random_unit<const D: usize>(rng: &mut Stream) -> [f32; 3] {
         let xy = rng.bits(32);
         let z = if D == 3 { coord(rng.bits(16)) } else { 0.0 };
         let v = [coord(xy & 0xffff), coord(xy >> 16), z];
-        let r2 = dot(v, v);
+        let r2 = dot_of::<D>(v, v);
         if r2 > 1.0 / 64.0 && r2 <= 1.0 {
             let inv = 1.0 / libm::sqrtf(r2);
             return v.map(|c| c * inv);
@@ -121,14 +121,14 @@ pub(crate) fn shares(ma: f32, mb: f32) -> (f32, f32) {
 /// Eqs. 7-8: the velocities after a collision of particles with mass shares
 /// `(sa, sb)` (see [`shares`]), restitution `e` and random unit vector `r`.
 /// Momentum is conserved exactly in real arithmetic, and the relative speed
-/// is scaled by `e`.
+/// is scaled by `e`. Components from `D` on are 0 in and out.
 #[inline]
-pub(crate) fn collide_pair(va: [f32; 3], vb: [f32; 3], (sa, sb): (f32, f32), e: f32, r: [f32; 3]) -> ([f32; 3], [f32; 3]) {
+pub(crate) fn collide_pair<const D: usize>(va: [f32; 3], vb: [f32; 3], (sa, sb): (f32, f32), e: f32, r: [f32; 3]) -> ([f32; 3], [f32; 3]) {
     let rel = [va[0] - vb[0], va[1] - vb[1], va[2] - vb[2]];
-    let speed = e * libm::sqrtf(dot(rel, rel));
+    let speed = e * libm::sqrtf(dot_of::<D>(rel, rel));
     let mut a = [0.0; 3];
     let mut b = [0.0; 3];
-    for k in 0..3 {
+    for k in 0..D {
         let v0 = sa * va[k] + sb * vb[k]; // centre-of-mass velocity V0
         a[k] = v0 + sb * speed * r[k]; // eq. 7
         b[k] = v0 - sa * speed * r[k]; // eq. 8
@@ -152,16 +152,16 @@ pub(crate) fn collide_limited<const D: usize>(
     limit: f32,
     rng: &mut Stream,
 ) -> ([f32; 3], [f32; 3]) {
-    let fits = |v: [f32; 3]| dot(v, v) <= limit * limit;
+    let fits = |v: [f32; 3]| dot_of::<D>(v, v) <= limit * limit;
     for _ in 0..SPEED_LIMIT_TRIES {
-        let (a, b) = collide_pair(va, vb, s, e, random_unit::<D>(rng));
+        let (a, b) = collide_pair::<D>(va, vb, s, e, random_unit::<D>(rng));
         if fits(a) && fits(b) {
             return (a, b);
         }
     }
     let rel = [va[0] - vb[0], va[1] - vb[1], va[2] - vb[2]];
     // rel = 0 leaves both at V0 whatever R is; an axis will do.
-    collide_pair(va, vb, s, e, normalise(rel).unwrap_or([1.0, 0.0, 0.0]))
+    collide_pair::<D>(va, vb, s, e, normalise(rel).unwrap_or([1.0, 0.0, 0.0]))
 }
 
 /// M1b: the pair `(a, b)`, just collided, with mass shares `(sa, sb)` and
@@ -172,22 +172,23 @@ pub(crate) fn collide_limited<const D: usize>(
 /// sides are divided by the pair's mass, so only the shares appear:
 /// `sa sb |a - b|^2 (1 - l^2) = sa Fa + sb Fb` with `F` the summed
 /// `f (1 - f)`. Momentum is untouched; a pair with less relative energy
-/// than that ends at its centre-of-mass velocity.
+/// than that ends at its centre-of-mass velocity. Components from `D` on
+/// are 0 in and out.
 #[inline]
-pub(crate) fn energy_neutral(a: [f32; 3], b: [f32; 3], (sa, sb): (f32, f32)) -> ([f32; 3], [f32; 3]) {
+pub(crate) fn energy_neutral<const D: usize>(a: [f32; 3], b: [f32; 3], (sa, sb): (f32, f32)) -> ([f32; 3], [f32; 3]) {
     let gain = |x: [f32; 3]| {
-        x.iter().fold(0.0, |sum, &c| {
+        x[..D].iter().fold(0.0, |sum, &c| {
             let m = c.abs();
             let f = m - m as i32 as f32; // the fraction; f (1 - f) is even in c
             sum + f * (1.0 - f)
         })
     };
     let rel = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
-    let kinetic = sa * sb * dot(rel, rel);
+    let kinetic = sa * sb * dot_of::<D>(rel, rel);
     let lost = sa * gain(a) + sb * gain(b);
     let l = if kinetic > lost { libm::sqrtf(1.0 - lost / kinetic) } else { 0.0 };
     let mut out = (a, b);
-    for k in 0..3 {
+    for k in 0..D {
         let v0 = sa * a[k] + sb * b[k];
         out.0[k] = v0 + l * (a[k] - v0);
         out.1[k] = v0 + l * (b[k] - v0);
@@ -203,6 +204,7 @@ pub(crate) const SPEED_LIMIT_TRIES: u32 = 16;
 mod tests {
     use super::*;
     use crate::rng::block_stream;
+    use crate::vector::dot;
 
     #[test]
     fn pair_tables_list_each_pair_once() {
@@ -235,7 +237,7 @@ mod tests {
             let va = [0.3, -0.2, 0.1];
             let vb = [-0.4, 0.5, 0.0];
             let (ma, mb, e) = (2.0, 0.5, 0.7);
-            let (a, b) = collide_pair(va, vb, shares(ma, mb), e, r);
+            let (a, b) = collide_pair::<3>(va, vb, shares(ma, mb), e, r);
             let mut rel_before = 0.0;
             let mut rel_after = 0.0;
             for k in 0..3 {
@@ -291,7 +293,7 @@ mod tests {
             let a = random_unit::<3>(&mut rng).map(|c| c * 127.0 * rng.unit());
             let b = random_unit::<3>(&mut rng).map(|c| c * 127.0 * rng.unit());
             let (ma, mb) = (1.0 + (i % 4) as f32, 1.0);
-            let (a2, b2) = energy_neutral(a, b, shares(ma, mb));
+            let (a2, b2) = energy_neutral::<3>(a, b, shares(ma, mb));
             let before = f64::from(energy(a, ma) + energy(b, mb));
             let after = f64::from(energy(a2, ma) + energy(b2, mb) + gain(a2, ma) + gain(b2, mb));
             let moved = |x: [f32; 3], y: [f32; 3], m: f32| 0.5 * m * (0..3).map(|k| (x[k] - y[k]).abs()).sum::<f32>();
@@ -312,7 +314,7 @@ mod tests {
     fn extreme_masses_stay_finite() {
         let r = [1.0, 0.0, 0.0];
         for (ma, mb) in [(1e-30, 1e30), (1e30, 1e-30), (3e38, 3e38), (1e-45, 1e-45)] {
-            let (a, b) = collide_pair([0.5, 0.0, 0.0], [-0.5, 0.0, 0.0], shares(ma, mb), 1.0, r);
+            let (a, b) = collide_pair::<3>([0.5, 0.0, 0.0], [-0.5, 0.0, 0.0], shares(ma, mb), 1.0, r);
             assert!(a.iter().chain(b.iter()).all(|c| c.is_finite()), "{ma} {mb}: {a:?} {b:?}");
         }
     }

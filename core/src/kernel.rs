@@ -48,7 +48,7 @@ use crate::obstacle::{reflect, surface_at, Surface};
 use crate::partition::{cells_at, resolve, BlockRow, BlockSink, Beyond, Index, Partition};
 use crate::quant::Quant;
 use crate::rng::{StepKey, Stream};
-use crate::vector::{clamp, dot, normalise};
+use crate::vector::{clamp_of, dot, dot_of, normalise};
 use crate::layout::{mark, put_bit};
 use crate::world::{Counters, ENERGY_SCALE};
 
@@ -301,8 +301,8 @@ pub(crate) fn back_normal<const D: usize>(from: usize, to: usize) -> [f32; 3] {
 /// M5.5: clamps `x` (in quanta) to the speed limit `scale`, counting the
 /// clamp and the kinetic energy it removed for mass `m`.
 #[inline(always)]
-fn clamp_counted(x: &mut [f32; 3], scale: f32, m: f32, counters: &mut Counters) {
-    if let Some(s2) = clamp(x, scale) {
+fn clamp_counted<const D: usize>(x: &mut [f32; 3], scale: f32, m: f32, counters: &mut Counters) {
+    if let Some(s2) = clamp_of::<D>(x, scale) {
         count_clamp(s2 / (scale * scale), m, counters);
     }
 }
@@ -413,7 +413,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
         for k in 0..D {
             x[k] += dv[k];
         }
-        clamp_counted(&mut x, Q::SCALE, m, &mut self.counters);
+        clamp_counted::<D>(&mut x, Q::SCALE, m, &mut self.counters);
         b.set(c, x);
     }
 
@@ -439,22 +439,22 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
     #[inline(always)]
     fn collide_two(&mut self, va: [f32; 3], vc: [f32; 3], (ma, mc): (f32, f32), equal: bool, rng: &mut Stream) -> Option<([f32; 3], [f32; 3])> {
         self.counters.collisions += 1;
-        if va == vc && dot(va, va) <= Q::SCALE * Q::SCALE {
+        if va == vc && dot_of::<D>(va, va) <= Q::SCALE * Q::SCALE {
             return None;
         }
         let s = if equal { (0.5, 0.5) } else { shares(ma, mc) };
         let e = self.shared.desc.restitution;
         let (mut xa, mut xc) = match self.shared.desc.collisions {
-            Collisions::Paper => collide_pair(va, vc, s, e, random_unit::<D>(rng)),
+            Collisions::Paper => collide_pair::<D>(va, vc, s, e, random_unit::<D>(rng)),
             // Below the limit by sqrt(D) quanta, so that rounding (less than a
             // quantum per component) cannot store a speed above 1 either.
             Collisions::SpeedLimited => collide_limited::<D>(va, vc, s, e, Q::SCALE - ROUNDING_MARGIN[D - 2], rng),
         };
         if self.shared.desc.energy_neutral {
-            (xa, xc) = energy_neutral(xa, xc, s);
+            (xa, xc) = energy_neutral::<D>(xa, xc, s);
         }
-        clamp_counted(&mut xa, Q::SCALE, ma, &mut self.counters);
-        clamp_counted(&mut xc, Q::SCALE, mc, &mut self.counters);
+        clamp_counted::<D>(&mut xa, Q::SCALE, ma, &mut self.counters);
+        clamp_counted::<D>(&mut xc, Q::SCALE, mc, &mut self.counters);
         Some((xa, xc))
     }
 
@@ -549,7 +549,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
             back
         };
         let mut x = reflect(x, n, e); // eq. 9
-        clamp_counted(&mut x, Q::SCALE, m, &mut self.counters);
+        clamp_counted::<D>(&mut x, Q::SCALE, m, &mut self.counters);
         b.set(c, x);
         b.round::<Q>(rng);
     }
@@ -617,12 +617,12 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
             }
             let (ma, mh) = (mass(a), mass(h));
             let s = if equal { (0.5, 0.5) } else { shares(ma, mh) };
-            let (mut ya, mut yh) = collide_pair(xa, xh, s, self.shared.desc.restitution, r);
+            let (mut ya, mut yh) = collide_pair::<D>(xa, xh, s, self.shared.desc.restitution, r);
             if self.shared.desc.energy_neutral {
-                (ya, yh) = energy_neutral(ya, yh, s);
+                (ya, yh) = energy_neutral::<D>(ya, yh, s);
             }
-            clamp_counted(&mut ya, Q::SCALE, ma, &mut self.counters);
-            clamp_counted(&mut yh, Q::SCALE, mh, &mut self.counters);
+            clamp_counted::<D>(&mut ya, Q::SCALE, ma, &mut self.counters);
+            clamp_counted::<D>(&mut yh, Q::SCALE, mh, &mut self.counters);
             b.set(a, ya);
             b.set(h, yh);
         }
@@ -721,8 +721,20 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
             let Some((xa, xc)) = self.collide_two(lane_quanta(lanes, a), lane_quanta(lanes, c), (mass, mass), true, rng) else {
                 return (lanes, 0);
             };
-            lanes = round_into(lanes, a, xa, rng);
-            return (round_into(lanes, c, xc, rng), 1 << a | 1 << c);
+            // The four components together: 32 bits for a, then 32 for c.
+            let r = [rng.bits(32), rng.bits(32)];
+            let x = [xa[0], xa[1], xc[0], xc[1]];
+            let q: [i32; 4] = core::array::from_fn(|i| Q::stochastic(x[i], r[i / 2] >> (16 * (i & 1))));
+            // 8-bit rounding stays within the stored range (+-127): the
+            // lane is the value's low byte.
+            let lane = |q: i32| {
+                debug_assert_eq!(q, Q::from_int(q).to_int());
+                u64::from(q as u8)
+            };
+            let (at_a, at_c) = (16 * a, 16 * c);
+            lanes &= !(0xffff << at_a | 0xffff << at_c);
+            lanes |= (lane(q[0]) | lane(q[1]) << 8) << at_a | (lane(q[2]) | lane(q[3]) << 8) << at_c;
+            return (lanes, 1 << a | 1 << c);
         }
         let mut x = [[0.0f32; 3]; CELLS];
         let mut pending = 0u8;
@@ -731,7 +743,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
                 let mut y = lane_quanta(lanes, c);
                 y[0] += dv[0];
                 y[1] += dv[1];
-                clamp_counted(&mut y, Q::SCALE, mass, &mut self.counters);
+                clamp_counted::<D>(&mut y, Q::SCALE, mass, &mut self.counters);
                 x[c] = y;
             }
             pending = occ;
@@ -920,7 +932,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
                 for k in 0..D {
                     x[k] = (x[k] + a * u[k]) / (1.0 + a);
                 }
-                clamp_counted(&mut x, Q::SCALE, mass[c], &mut self.counters);
+                clamp_counted::<D>(&mut x, Q::SCALE, mass[c], &mut self.counters);
                 b.set(c, x);
             }
         }

@@ -72,15 +72,18 @@ pub(crate) trait Quant: Copy + Default + Send + crate::layout::Plain + 'static {
     #[inline(always)]
     fn stochastic(x: f32, r: u32) -> i32 {
         let x = x.clamp(-Self::SCALE, Self::SCALE);
-        if x.is_nan() {
-            return 0;
-        }
         if Self::SCALE < 128.0 {
+            // NaN as 0, which the sum below rounds to 0: a select, not a
+            // branch, so that several components round in one vector.
+            let x = if x.is_nan() { 0.0 } else { x };
             let y = (x + 128.0) + (r & 0xffff) as f32 * (1.0 / 65536.0);
             // SAFETY: x is in [-127, 127] (clamped, and not NaN), so y is
             // finite and in [1, 256): its integer part fits an i32. (A
             // checked cast would test for NaN and both bounds again.)
             return unsafe { y.to_int_unchecked::<i32>() } - 128;
+        }
+        if x.is_nan() {
+            return 0;
         }
         let x = x * 65536.0;
         // SAFETY: x is in [-32767, 32767] 2^16 (clamped, not NaN): the sum is

@@ -4,7 +4,19 @@
 
 #[inline]
 pub(crate) fn dot(a: [f32; 3], b: [f32; 3]) -> f32 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+    dot_of::<3>(a, b)
+}
+
+/// The dot product of the first `D` components, summed in the order
+/// [`dot`] sums them: where the others are 0 (a 2D velocity), the same
+/// value, without the arithmetic on zeros.
+#[inline(always)]
+pub(crate) fn dot_of<const D: usize>(a: [f32; 3], b: [f32; 3]) -> f32 {
+    let mut sum = a[0] * b[0];
+    for k in 1..D {
+        sum += a[k] * b[k];
+    }
+    sum
 }
 
 /// `v / |v|`, or `None` where the length is zero or not finite.
@@ -23,7 +35,13 @@ pub(crate) fn normalise(v: [f32; 3]) -> Option<[f32; 3]> {
 /// as zero. The squared length is then reported as infinite.
 #[inline]
 pub(crate) fn clamp(v: &mut [f32; 3], limit: f32) -> Option<f32> {
-    let s2 = dot(*v, *v);
+    clamp_of::<3>(v, limit)
+}
+
+/// [`clamp`] of a velocity whose components from `D` on are 0.
+#[inline(always)]
+pub(crate) fn clamp_of<const D: usize>(v: &mut [f32; 3], limit: f32) -> Option<f32> {
+    let s2 = dot_of::<D>(*v, *v);
     if s2 <= limit * limit {
         return None;
     }
