@@ -807,6 +807,22 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
             }
         }
 
+        self.counters.processed += 1;
+        if want != 0 || pending != 0 {
+            self.finish_2d(row, x0, occ, lanes, want, pending, &mut rng);
+        }
+    }
+
+    /// The rest of [`Kernel::lean_2d`] for a block where a particle wants
+    /// to move or a velocity changed (`pending`): M5.6, then the moved and
+    /// changed velocities and the occupancy written back. Out of line: in
+    /// a cooling gas most blocks need neither, and the sweep's loop keeps
+    /// its registers.
+    #[inline(never)]
+    #[allow(clippy::too_many_arguments)]
+    fn finish_2d(&mut self, row: &BlockRow, x0: usize, occ: u8, lanes: u64, want: u8, pending: u8, rng: &mut Stream) {
+        let sh = self.shared;
+        let velocity = self.planes.velocity;
         // M5.6.
         let targets = if want == 0 {
             IDENTITY
@@ -815,10 +831,8 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
             let mut per_cell = [0u8; CELLS];
             per_cell[..4].copy_from_slice(&wants);
             let key = 2 * usize::from(BLOCKED_KEY_2D[usize::from(occ)]) + usize::from(KEY_2D_WANTS[usize::from(want)]);
-            self.assign(occ, |c| { let x = lane_quanta(lanes, c); dot(x, x) }, 0, &per_cell, key, &mut rng)
+            self.assign(occ, |c| { let x = lane_quanta(lanes, c); dot(x, x) }, 0, &per_cell, key, rng)
         };
-
-        self.counters.processed += 1;
         let moved = (targets ^ IDENTITY) & FIELDS[usize::from(occ)] != 0;
         if !moved && pending == 0 {
             return;

@@ -45,12 +45,17 @@ pub(crate) fn clamp_of<const D: usize>(v: &mut [f32; 3], limit: f32) -> Option<f
     if s2 <= limit * limit {
         return None;
     }
-    clamp_long(v, s2, limit)
+    // By value: a velocity whose address never escapes stays in registers.
+    let (w, s2) = clamp_long(*v, s2, limit);
+    *v = w;
+    Some(s2)
 }
 
-/// The part of [`clamp`] that runs only when it clamps.
+/// The part of [`clamp`] that runs only when it clamps: the clamped
+/// velocity and the squared length it had.
 #[cold]
-fn clamp_long(v: &mut [f32; 3], s2: f32, limit: f32) -> Option<f32> {
+fn clamp_long(mut v: [f32; 3], s2: f32, limit: f32) -> ([f32; 3], f32) {
+    let v = &mut v;
     if !s2.is_finite() {
         // In units of the limit, so that "short enough" means length <= 1.
         for c in v.iter_mut() {
@@ -74,13 +79,13 @@ fn clamp_long(v: &mut [f32; 3], s2: f32, limit: f32) -> Option<f32> {
         for c in v.iter_mut() {
             *c *= limit;
         }
-        return Some(f32::INFINITY);
+        return (*v, f32::INFINITY);
     }
     let scale = limit / libm::sqrtf(s2);
     for c in v.iter_mut() {
         *c *= scale;
     }
-    Some(s2)
+    (*v, s2)
 }
 
 #[cfg(test)]
