@@ -74,6 +74,19 @@ impl<'a, T: Copy> Cells<'a, T> {
         unsafe { [self.ptr.as_ptr().add(i).read(), self.ptr.as_ptr().add(i + 1).read()] }
     }
 
+    /// Sets elements `i` and `i + 1`, with one bounds check.
+    #[inline(always)]
+    pub fn set_pair(&self, i: usize, v: [T; 2]) {
+        if self.len < 2 || i > self.len - 2 {
+            out_of_bounds(i + 1, self.len);
+        }
+        // SAFETY: as in `get`, for both elements.
+        unsafe {
+            self.ptr.as_ptr().add(i).write(v[0]);
+            self.ptr.as_ptr().add(i + 1).write(v[1]);
+        }
+    }
+
     /// Sets element `i` to `v`.
     #[inline(always)]
     pub fn set(&self, i: usize, v: T) {

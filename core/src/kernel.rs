@@ -240,8 +240,14 @@ fn lane_quanta(lanes: u64, c: usize) -> [f32; 3] {
 /// Cell `c`'s stored velocity in byte lanes, as integers.
 #[inline(always)]
 fn lane_ints(lanes: u64, c: usize) -> [i8; 2] {
-    let q = (lanes >> (16 * c)) as u16;
+    let q = cell_lanes(lanes, c);
     [q as u8 as i8, (q >> 8) as u8 as i8]
+}
+
+/// Cell `c`'s two byte lanes, in the low 16 bits.
+#[inline(always)]
+fn cell_lanes(lanes: u64, c: usize) -> u32 {
+    u32::from((lanes >> (16 * c)) as u16)
 }
 
 /// Runs `$body` once for each cell of a block of `$cells` cells, with `$c`
@@ -833,8 +839,14 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
             let key = 2 * usize::from(BLOCKED_KEY_2D[usize::from(occ)]) + usize::from(KEY_2D_WANTS[usize::from(want)]);
             self.assign(occ, |c| { let x = lane_quanta(lanes, c); dot(x, x) }, 0, &per_cell, key, rng)
         };
-        let moved = (targets ^ IDENTITY) & FIELDS[usize::from(occ)] != 0;
-        if !moved && pending == 0 {
+        if (targets ^ IDENTITY) & FIELDS[usize::from(occ)] == 0 {
+            // Nothing moved: the block rows holding a changed velocity are
+            // written back whole from the lanes (the other cell as it was).
+            for r in 0..2 {
+                if pending >> (2 * r) & 3 != 0 {
+                    velocity.set_pair(x0 + row.cell[r], Q::pair_from_lanes((lanes >> (32 * r)) as u32));
+                }
+            }
             return;
         }
         let mut after = 0u8;
@@ -843,27 +855,23 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
                 let t = (targets >> (4 * c) & 7) as usize;
                 after |= 1 << t;
                 if t != c || pending >> c & 1 != 0 {
-                    let q = lane_ints(lanes, c);
-                    let mut stored = [Q::default(); D];
-                    stored[0] = Q::from_int(q[0].into());
-                    stored[1] = Q::from_int(q[1].into());
+                    // Cell c's two lanes, as the first cell of a pair.
+                    let [stored, _] = Q::pair_from_lanes(cell_lanes(lanes, c));
                     velocity.set(x0 + (t & 1) + row.cell[t >> 1], stored);
                 }
             }
         });
-        if moved {
-            let shift = x0 & 63;
-            for r in 0..2 {
-                let (old, new) = (u64::from(occ >> (2 * r) & 3), u64::from(after >> (2 * r) & 3));
-                if old != new {
-                    let at = row.word[r] + (x0 >> 6);
-                    let w = self.planes.occupancy.get(at);
-                    self.planes.occupancy.set(at, w & !(3 << shift) | new << shift);
-                    // A row that held no particle of the block may have been
-                    // swept as empty: flag it again (M3).
-                    if old == 0 {
-                        mark(self.planes.rows, self.planes.words, sh.part.summary_words, row.line[r], x0);
-                    }
+        let shift = x0 & 63;
+        for r in 0..2 {
+            let (old, new) = (u64::from(occ >> (2 * r) & 3), u64::from(after >> (2 * r) & 3));
+            if old != new {
+                let at = row.word[r] + (x0 >> 6);
+                let w = self.planes.occupancy.get(at);
+                self.planes.occupancy.set(at, w & !(3 << shift) | new << shift);
+                // A row that held no particle of the block may have been
+                // swept as empty: flag it again (M3).
+                if old == 0 {
+                    mark(self.planes.rows, self.planes.words, sh.part.summary_words, row.line[r], x0);
                 }
             }
         }

@@ -44,6 +44,8 @@ pub(crate) trait Quant: Copy + Default + Send + crate::layout::Plain + 'static {
     /// holding cell `c`'s component `k` (where [`Quant::LANES`]; 0
     /// otherwise).
     fn lanes_2d<const D: usize>(pair: [[Self; D]; 2]) -> u32;
+    /// The inverse of [`Quant::lanes_2d`] (where [`Quant::LANES`]).
+    fn pair_from_lanes<const D: usize>(lanes: u32) -> [[Self; D]; 2];
 
     #[inline]
     fn get(self) -> f32 {
@@ -155,6 +157,13 @@ impl Quant for i8 {
     fn lanes_2d<const D: usize>(pair: [[Self; D]; 2]) -> u32 {
         u32::from_le_bytes([pair[0][0] as u8, pair[0][1] as u8, pair[1][0] as u8, pair[1][1] as u8])
     }
+    #[inline(always)]
+    fn pair_from_lanes<const D: usize>(lanes: u32) -> [[Self; D]; 2] {
+        let b = lanes.to_le_bytes().map(|b| b as i8);
+        let mut pair = [[0; D]; 2];
+        (pair[0][0], pair[0][1], pair[1][0], pair[1][1]) = (b[0], b[1], b[2], b[3]);
+        pair
+    }
     #[inline]
     fn from_int(q: i32) -> Self {
         q.clamp(-127, 127) as i8
@@ -175,6 +184,9 @@ impl Quant for i16 {
     const LANES: bool = false;
     fn lanes_2d<const D: usize>(_: [[Self; D]; 2]) -> u32 {
         0
+    }
+    fn pair_from_lanes<const D: usize>(_: u32) -> [[Self; D]; 2] {
+        [[0; D]; 2]
     }
     #[inline]
     fn from_int(q: i32) -> Self {
