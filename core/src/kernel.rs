@@ -79,6 +79,9 @@ pub(crate) struct Shared<'a> {
     /// and without an obstacle go through [`Kernel::lean`] (or
     /// [`Kernel::lean_2d`]).
     pub plain: bool,
+    /// `plain` without contacts (M5.7): what [`Kernel::lean_2d`] needs of
+    /// the step, tested once a block.
+    pub lanes: bool,
 }
 
 /// The planes a step writes; `velocity` holds a cell's `D` components
@@ -1034,18 +1037,20 @@ impl<'a, Q: Quant, const D: usize, const CELLS: usize> BlockSink<'a> for Kernel<
     #[inline(always)]
     fn visit(&mut self, row: &BlockRow, x0: isize, bx: usize, occ: u8) {
         let sh = self.shared;
+        if D == 2 && Q::LANES {
+            // 2D, 8 bits: the lanes routine or the general one (the few
+            // blocks across a word or the wrap, the half blocks, worlds with
+            // contacts), never `lean`, which this routine then leaves out.
+            // x0 = -1 (a half block) fails the test on x0 + 1 as a usize.
+            let x = x0 as usize;
+            let pairwise = sh.lanes && row.outside == 0 && x & 63 != 63 && x.wrapping_add(1) < sh.n[0];
+            if pairwise && (!sh.desc.obstacles || read_block::<CELLS>(sh.obstacle, row, [x, x + 1]) == 0) {
+                return self.lean_2d(row, x, row.index + bx as u64, occ);
+            }
+            return self.general(row, x0, bx, occ);
+        }
         if sh.plain && row.outside == 0 && x0 >= 0 {
             let x0 = x0 as usize;
-            if D == 2 && Q::LANES {
-                // 2D, 8 bits: the lanes routine or the general one (the
-                // few blocks across a word or the wrap, worlds with
-                // contacts), never `lean`, which this routine then leaves out.
-                let pairwise = !sh.desc.contacts && x0 & 63 != 63 && x0 + 1 < sh.n[0];
-                if pairwise && (!sh.desc.obstacles || read_block::<CELLS>(sh.obstacle, row, [x0, x0 + 1]) == 0) {
-                    return self.lean_2d(row, x0, row.index + bx as u64, occ);
-                }
-                return self.general(row, x0 as isize, bx, occ);
-            }
             let x1 = if x0 + 1 < sh.n[0] { Some(x0 + 1) } else { sh.part.axes[0].periodic.then_some(0) };
             if let Some(x1) = x1 {
                 // A world with obstacles: only blocks without one are lean.

@@ -176,6 +176,7 @@ impl World {
         // Fields, potentials, the vortex and drag are summed per particle;
         // a uniform force alone is one precomputed change (`push`).
         let summed = cfg!(feature = "fields") && (desc.forces.any_field() || desc.drag.rate > 0.0);
+        let plain = route.lean && !desc.per_particle_mass && !desc.lifetimes && !summed;
         let shared = Shared {
             desc,
             n,
@@ -193,7 +194,8 @@ impl World {
             }),
             moves: crate::quant::move_table_8(desc.drift),
             summed,
-            plain: route.lean && !desc.per_particle_mass && !desc.lifetimes && !summed,
+            plain,
+            lanes: plain && !desc.contacts,
         };
         let planes = Writable {
             occupancy: Cells::new(occupancy),
