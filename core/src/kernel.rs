@@ -771,8 +771,8 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
     }
 
     /// [`Kernel::lean`] for a 2D block of an 8-bit world whose two cells of
-    /// each row are neighbours in one occupancy word (`x0 % 64 != 63`, no
-    /// wrap), in a world without contacts. The block's stored velocities
+    /// each row are neighbours (no wrap: `x0 + 1 < nx`), in a world without
+    /// contacts. The block's stored velocities
     /// are read as one 64-bit word of byte lanes, lane `2c + k` holding cell
     /// `c`'s component `k` (two 32-bit reads, one a block row): which
     /// particles want to cross an axis inward is a handful of word
@@ -864,6 +864,10 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
                 }
             }
         });
+        if x0 & 63 == 63 {
+            // The block's cells lie in two occupancy words (rare).
+            return self.occupy(row, [x0, x0 + 1], occ, after);
+        }
         let shift = x0 & 63;
         for r in 0..2 {
             let (old, new) = (u64::from(occ >> (2 * r) & 3), u64::from(after >> (2 * r) & 3));
@@ -1039,11 +1043,12 @@ impl<'a, Q: Quant, const D: usize, const CELLS: usize> BlockSink<'a> for Kernel<
         let sh = self.shared;
         if D == 2 && Q::LANES {
             // 2D, 8 bits: the lanes routine or the general one (the few
-            // blocks across a word or the wrap, the half blocks, worlds with
+            // blocks across the wrap, the half blocks, worlds with
             // contacts), never `lean`, which this routine then leaves out.
-            // x0 = -1 (a half block) fails the test on x0 + 1 as a usize.
+            // The half block's x0 = -1 is usize::MAX here, which fails the
+            // test on x (n >= 1: Layout::of refuses an empty axis).
             let x = x0 as usize;
-            let pairwise = sh.lanes && row.outside == 0 && x & 63 != 63 && x.wrapping_add(1) < sh.n[0];
+            let pairwise = sh.lanes && row.outside == 0 && x < sh.n[0] - 1;
             if pairwise && (!sh.desc.obstacles || read_block::<CELLS>(sh.obstacle, row, [x, x + 1]) == 0) {
                 return self.lean_2d(row, x, row.index + bx as u64, occ);
             }

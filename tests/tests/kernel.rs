@@ -37,13 +37,18 @@ fn gas<'a>(desc: &Description, density: f32, speed: f32, seed: u64, memory: &'a 
 /// half blocks take the general routine in both runs); no force and
 /// gravity; with and without an obstacle; both widths, both drift rules,
 /// all three methods, both collision rules, with and without contacts and
-/// energy-neutral rounding.
+/// energy-neutral rounding. 2D worlds 48 wide (one occupancy word a row)
+/// and 130 wide (blocks across two words).
 fn settings() -> Vec<Description> {
     let mut out = vec![];
-    for dim in [2u32, 3] {
+    for (dim, wide) in [(2u32, false), (2, true), (3, false)] {
         for (i, faces) in [Boundary::Periodic, Boundary::Wall, Boundary::Open].into_iter().enumerate() {
             for variant in 0..4usize {
-                let mut d = if dim == 2 { Description::new_2d(48, 40) } else { Description::new_3d(12, 10, 14) };
+                let mut d = match (dim, wide) {
+                    (2, false) => Description::new_2d(48, 40),
+                    (2, true) => Description::new_2d(130, 16),
+                    _ => Description::new_3d(12, 10, 14),
+                };
                 d = d.with_boundary(faces);
                 d.quantization = [Quantization::Bits8, Quantization::Bits16][variant % 2];
                 d.drift = [Drift::Paper, Drift::Calibrated][variant / 2];
@@ -60,7 +65,7 @@ fn settings() -> Vec<Description> {
                     d.obstacles = true;
                     d.surface_capacity = 512;
                 }
-                d.seed = 900 + 10 * u64::from(dim) + (4 * i + variant) as u64;
+                d.seed = 900 + 10 * u64::from(dim) + 100 * u64::from(wide) + (4 * i + variant) as u64;
                 out.push(d);
             }
         }
