@@ -772,14 +772,14 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
 
     /// [`Kernel::lean`] for a 2D block of an 8-bit world whose two cells of
     /// each row are neighbours (no wrap: `x0 + 1 < nx`), in a world without
-    /// contacts. The block's stored velocities
-    /// are read as one 64-bit word of byte lanes, lane `2c + k` holding cell
-    /// `c`'s component `k` (two 32-bit reads, one a block row): which
-    /// particles want to cross an axis inward is a handful of word
-    /// operations for the whole block, and only those axes read the move
-    /// table. A velocity a stage changes is rounded back into its lanes.
-    /// The draws are those of [`Kernel::general`], in the same order, so
-    /// the world is the same bit for bit.
+    /// contacts. The block's stored velocities are read as one 64-bit word
+    /// of byte lanes, lane `2c + k` holding cell `c`'s component `k` (two
+    /// 32-bit reads, one a block row): which particles want to cross an
+    /// axis inward is a handful of word operations for the whole block, and
+    /// only those axes read the move table. A velocity a stage changes is
+    /// rounded back into its lanes. The draws are those of
+    /// [`Kernel::general`], in the same order, so the world is the same bit
+    /// for bit.
     #[inline(always)]
     fn lean_2d(&mut self, row: &BlockRow, x0: usize, index: u64, occ: u8) {
         let sh = self.shared;
