@@ -1041,6 +1041,9 @@ impl<'a, Q: Quant, const D: usize, const CELLS: usize> BlockSink<'a> for Kernel<
     #[inline(always)]
     fn visit(&mut self, row: &BlockRow, x0: isize, bx: usize, occ: u8) {
         let sh = self.shared;
+        if cfg!(feature = "small-step") {
+            return self.general(row, x0, bx, occ);
+        }
         if D == 2 && Q::LANES {
             // 2D, 8 bits: the lanes routine or the general one (the few
             // blocks across the wrap, the half blocks, worlds with
