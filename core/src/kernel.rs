@@ -527,7 +527,10 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
             }
         }
         let (n, e) = surface.unwrap_or_else(|| match surface_at(sh.surface, to.site as u32) {
-            Some(s) => (s.normal, s.restitution),
+            // Component by component: a copy of the array through the
+            // reference is a `memmove` call at opt-level z, the only one
+            // in a firmware build (1.5 KB of flash).
+            Some(s) => ([s.normal[0], s.normal[1], s.normal[2]], s.restitution),
             // Unreachable for obstacles added through the API (every cell
             // next to a free one has an entry): the direction back to the
             // particle.
