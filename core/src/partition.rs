@@ -38,7 +38,10 @@ pub(crate) enum Beyond {
 
 /// M4: what lies at the (possibly out-of-domain) cell coordinates `c` of a
 /// domain of `n` cells per axis with faces `boundary`. Axes beyond the
-/// world's dimension have `n = 1` and `c = 0`.
+/// world's dimension have `n = 1` and `c = 0`. Every caller asks for a
+/// neighbour of a cell, so each coordinate lies within one domain length
+/// of the domain (`-n <= c < 2n`): a periodic face wraps it with one add
+/// (no 64-bit division, which small cores call a library routine for).
 pub(crate) fn resolve(n: [usize; 3], boundary: &[[Boundary; 2]; 3], c: [i64; 3]) -> Beyond {
     let mut out = [0usize; 3];
     let mut wall = [0.0f32; 3];
@@ -51,7 +54,10 @@ pub(crate) fn resolve(n: [usize; 3], boundary: &[[Boundary; 2]; 3], c: [i64; 3])
         }
         let high = c[k] >= nk;
         match boundary[k][usize::from(high)] {
-            Boundary::Periodic => out[k] = c[k].rem_euclid(nk) as usize,
+            Boundary::Periodic => {
+                debug_assert!((-nk..2 * nk).contains(&c[k]), "{c:?} beyond one domain length");
+                out[k] = if high { c[k] - nk } else { c[k] + nk } as usize;
+            }
             Boundary::Wall => {
                 is_wall = true;
                 wall[k] = if high { -1.0 } else { 1.0 };

@@ -131,7 +131,10 @@ impl Stream {
         let low = |m: u64| m & (u64::MAX >> (64 - width));
         if low(m) < u64::from(n) {
             // 2^width mod n: the low products below it are over-represented.
-            let threshold = ((1u64 << width) - u64::from(n)) % u64::from(n);
+            // In 32 bits (2^width - n fits): no 64-bit division, which small
+            // cores call a library routine for.
+            let span = if width == 16 { 1u32 << 16 } else { 0 };
+            let threshold = u64::from(span.wrapping_sub(n) % n);
             while low(m) < threshold {
                 m = u64::from(self.bits(width)) * u64::from(n);
             }
