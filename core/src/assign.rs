@@ -790,20 +790,22 @@ impl Prices {
         if price < i16::from(PRIMARY) {
             return 1 << at;
         }
-        let mut bytes = [0u8; MAX_CELLS];
-        for ((byte, &cost), &lift) in bytes.iter_mut().zip(costs).zip(&self.lift) {
-            *byte = u8::from(cost + lift == price);
+        // A mask from a compare of all eight lanes: one vector compare and
+        // a move of its sign bits where the target has them.
+        let mut cells = 0u8;
+        for t in 0..MAX_CELLS {
+            cells |= u8::from(costs[t] + self.lift[t] == price) << t;
         }
-        gather(bytes)
+        cells
     }
 
     /// The cells every optimal assignment fills: those with lift.
     fn must(&self) -> u8 {
-        let mut bytes = [0u8; MAX_CELLS];
-        for (byte, &lift) in bytes.iter_mut().zip(&self.lift) {
-            *byte = u8::from(lift > 0);
+        let mut cells = 0u8;
+        for t in 0..MAX_CELLS {
+            cells |= u8::from(self.lift[t] > 0) << t;
         }
-        gather(bytes)
+        cells
     }
 }
 
@@ -815,14 +817,6 @@ fn min_lane(lanes: &Lanes) -> i16 {
         half[t] = lanes[t].min(lanes[t + MAX_CELLS / 2]);
     }
     half[0].min(half[2]).min(half[1].min(half[3]))
-}
-
-/// Bit `t` set where byte `t` is 1 (all bytes 0 or 1): the multiply moves
-/// byte t's bit to bit 56 + t, and no two partial products meet below bit
-/// 64 in a way that carries into those eight.
-#[inline]
-fn gather(bytes: [u8; MAX_CELLS]) -> u8 {
-    (u64::from_le_bytes(bytes).wrapping_mul(0x0102_0408_1020_4080) >> 56) as u8
 }
 
 /// One optimal assignment, uniformly, from the placed prices.
