@@ -117,7 +117,7 @@ pub fn smoke_flow() -> Scene {
     desc.forces.uniform = true;
     desc.gravity = [0.0, 0.004, 0.0];
     desc.vortex = Vortex { centre: [64.0, 72.0], core_radius: 10.0, circulation: 9.0 };
-    desc.drag = mpca::Drag { rate: 0.05, wind: [0.0; 3], vortex: true };
+    desc.drag = mpca::Drag { rate: 0.05, wind: [0.0; 3], field: false, vortex: true };
     desc.emitter_capacity = 1;
     desc.seed = 43;
     Scene { name: "smoke-flow", section: "4.3b", desc, steps: 1200, paper_seconds: f64::NAN, setup: fill_smoke }

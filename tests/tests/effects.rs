@@ -258,23 +258,32 @@ fn energy_neutral_rounding_keeps_momentum_up_to_rounding() {
 
 /// M5.1b, one step of a particle at rest in a flow: backward Euler gives
 /// `v = dt k u / (1 + dt k)` exactly, here u / 3 (k = 0.5, dt = 1), stored
-/// to within one quantum by stochastic rounding; with the vortex read as a
-/// velocity the flow at the cell is the Rankine field.
+/// to within one quantum by stochastic rounding; the flow at the cell is
+/// the uniform wind, plus the wind plane's value at that cell (not a
+/// neighbour's), plus the Rankine field with the vortex read as a velocity.
 #[test]
 fn drag_relaxes_towards_the_flow_by_backward_euler() {
-    for vortex in [false, true] {
+    for (vortex, field) in [(false, false), (true, false), (false, true), (true, true)] {
         let mut desc = Description::new_2d(32, 32);
         desc.vortex = Vortex { centre: [16.0, 16.0], core_radius: 4.0, circulation: 3.0 };
-        desc.drag = Drag { rate: 0.5, wind: [0.4, -0.2, 0.0], vortex };
+        desc.drag = Drag { rate: 0.5, wind: [0.4, -0.2, 0.0], field, vortex };
         desc.seed = 2;
         let mut memory = vec![0u8; mpca::world_bytes(&desc).unwrap()];
         let w = World::init(&desc, &mut memory).unwrap();
         let pos = [22u32, 13, 0];
+        if field {
+            // Every other cell blows the other way.
+            w.set_wind_field(&[-0.5, 0.5].repeat(32 * 32)).unwrap();
+            w.set_cell_wind(pos, [-0.3, 0.5, 0.0]).unwrap();
+        }
         w.add_particle(pos, [0.0; 3]).unwrap();
         w.step(1);
         let p = w.particles().next().unwrap();
         // The drag acts before the move: the flow is that of the start cell.
         let mut u = [0.4f32, -0.2];
+        if field {
+            u = [u[0] - 0.3, u[1] + 0.5];
+        }
         if vortex {
             let (dx, dy) = (pos[0] as f32 + 0.5 - 16.0, pos[1] as f32 + 0.5 - 16.0);
             let s = 3.0 / (std::f32::consts::TAU * (dx * dx + dy * dy).max(16.0));
@@ -282,8 +291,83 @@ fn drag_relaxes_towards_the_flow_by_backward_euler() {
             u[1] += dx * s;
         }
         for k in 0..2 {
-            assert!((p.velocity[k] - u[k] / 3.0).abs() <= 1.0 / 127.0, "vortex {vortex}, axis {k}: {:?} vs {u:?} / 3", p.velocity);
+            assert!((p.velocity[k] - u[k] / 3.0).abs() <= 1.0 / 127.0, "vortex {vortex}, field {field}, axis {k}: {:?} vs {u:?} / 3", p.velocity);
         }
+    }
+}
+
+/// M5.1b's wind plane takes only what a flow can be: finite values, no
+/// cell faster than 1, the whole plane, a cell inside the world; a world
+/// built without the plane refuses both setters. A refused call sets
+/// nothing: the world's image, which holds the plane (M12), is the same
+/// byte for byte. The plane costs `dim` floats a cell when on, nothing off.
+#[test]
+fn the_wind_plane_refuses_what_no_flow_is_and_costs_nothing_when_off() {
+    for dim in [2u32, 3] {
+        let mut desc = if dim == 2 { Description::new_2d(8, 8) } else { Description::new_3d(4, 4, 4) };
+        let (cells, d) = (64usize, dim as usize);
+        desc.drag = Drag { rate: 0.2, wind: [0.1, 0.0, 0.0], field: false, vortex: false };
+        let without = mpca::world_bytes(&desc).unwrap();
+        let mut memory = vec![0u8; without];
+        let w = World::init(&desc, &mut memory).unwrap();
+        assert_eq!(w.set_wind_field(&vec![0.0; cells * d]), Err(mpca::Error::NotEnabled));
+        assert_eq!(w.set_cell_wind([1, 1, 0], [0.1, 0.0, 0.0]), Err(mpca::Error::NotEnabled));
+
+        desc.drag.field = true;
+        assert_eq!(mpca::world_bytes(&desc).unwrap(), without + cells * d * 4, "{dim}D");
+        let mut memory = vec![0u8; mpca::world_bytes(&desc).unwrap()];
+        let w = World::init(&desc, &mut memory).unwrap();
+        let plane: Vec<f32> = (0..cells * d).map(|i| (i % 5) as f32 * 0.1 - 0.2).collect();
+        w.set_wind_field(&plane).unwrap();
+        w.add_particle([1, 2, 0], [0.2, 0.0, 0.0]).unwrap();
+        let image = |w: &World| {
+            let mut out = vec![0u8; w.snapshot_bytes()];
+            w.save(&mut out).unwrap();
+            out
+        };
+        let before = image(w);
+        let too_fast = if dim == 2 { [0.8, 0.61, 0.0] } else { [0.6, 0.6, 0.6] };
+        let mut calls = vec![];
+        for (at, value) in [(0, f32::NAN), (cells * d - 1, f32::INFINITY), (d, f32::NEG_INFINITY), (3, 1.01), (cells * d - 2, -1.5)] {
+            let mut bad = plane.clone();
+            bad[at] = value;
+            calls.push((format!("plane[{at}] = {value}"), w.set_wind_field(&bad)));
+        }
+        let mut fast = plane.clone();
+        fast[d * 9..d * 10].copy_from_slice(&too_fast[..d]);
+        calls.push(("a cell of speed above 1".into(), w.set_wind_field(&fast)));
+        for len in [0, cells * d - 1, cells * d + 1, cells] {
+            calls.push((format!("length {len}"), w.set_wind_field(&vec![0.0; len])));
+        }
+        calls.push(("cell of speed above 1".into(), w.set_cell_wind([1, 1, 0], too_fast)));
+        calls.push(("cell wind NaN".into(), w.set_cell_wind([1, 1, 0], [0.0, f32::NAN, 0.0])));
+        calls.push(("cell outside".into(), w.set_cell_wind([8, 1, 0], [0.1, 0.0, 0.0])));
+        let wanted = [
+            mpca::Error::NotFinite,
+            mpca::Error::NotFinite,
+            mpca::Error::NotFinite,
+            mpca::Error::SpeedRange,
+            mpca::Error::SpeedRange,
+            mpca::Error::SpeedRange,
+            mpca::Error::BadLength,
+            mpca::Error::BadLength,
+            mpca::Error::BadLength,
+            mpca::Error::BadLength,
+            mpca::Error::SpeedRange,
+            mpca::Error::NotFinite,
+            mpca::Error::OutOfBounds,
+        ];
+        for ((what, got), want) in calls.into_iter().zip(wanted) {
+            assert_eq!(got, Err(want), "{dim}D {what}");
+        }
+        assert!(image(w) == before, "{dim}D: a refused call changed the world");
+        // A cell's value is taken as given, in the world's dimension: the
+        // cell (1, 1, 0) is plane cell 9.
+        let mut u = [0.0f32; 3];
+        u[..d].copy_from_slice(&plane[9 * d..10 * d]);
+        u[2] += 0.5;
+        w.set_cell_wind([1, 1, 0], u).unwrap();
+        assert_eq!(image(w) == before, dim == 2, "{dim}D: the third component counts in 3D only");
     }
 }
 
@@ -297,7 +381,7 @@ fn drag_gives_a_terminal_velocity() {
     let mut desc = Description::new_2d(64, 64);
     desc.forces.uniform = true;
     desc.gravity = [0.0, 0.01, 0.0];
-    desc.drag = Drag { rate: 0.1, wind: [0.2, 0.0, 0.0], vortex: false };
+    desc.drag = Drag { rate: 0.1, wind: [0.2, 0.0, 0.0], field: false, vortex: false };
     desc.seed = 3;
     let mut memory = vec![0u8; mpca::world_bytes(&desc).unwrap()];
     let w = World::init(&desc, &mut memory).unwrap();
