@@ -4,6 +4,7 @@
 //! And the flow that drag relaxes velocities towards (M5.1b).
 
 use crate::desc::{finite, Boundary, Vortex};
+use crate::layout::Planes;
 use crate::world::World;
 use crate::Error;
 
@@ -171,13 +172,31 @@ impl World {
 
     /// Sets the force on one cell. Needs `forces.field`.
     pub fn set_cell_force(&mut self, pos: [u32; 3], f: [f32; 3]) -> Result<(), Error> {
+        self.set_cell_vector(pos, self.head.desc.forces.field, f, false, |p| p.field)
+    }
+
+    /// Writes the first `dim` components of `v` at the cell `pos` of a
+    /// plane of `dim` floats a cell, which `plane` picks, after the checks
+    /// such a setter makes: a cell of the world, a plane the world has
+    /// (`enabled`), finite values and, for a velocity, a speed of at most 1.
+    fn set_cell_vector(
+        &mut self,
+        pos: [u32; 3],
+        enabled: bool,
+        v: [f32; 3],
+        velocity: bool,
+        plane: fn(Planes<'_, u8>) -> &mut [f32],
+    ) -> Result<(), Error> {
         let s = self.locate(pos)?;
-        if !self.head.desc.forces.field {
+        if !enabled {
             return Err(Error::NotEnabled);
         }
-        finite(&f)?;
+        finite(&v)?;
         let d = self.dim();
-        self.planes::<u8>().1.field[s.cell * d..s.cell * d + d].copy_from_slice(&f[..d]);
+        if velocity && !slow(v[..d].iter().copied()) {
+            return Err(Error::SpeedRange);
+        }
+        plane(self.planes::<u8>().1)[s.cell * d..s.cell * d + d].copy_from_slice(&v[..d]);
         Ok(())
     }
 
@@ -217,17 +236,7 @@ impl World {
     /// Sets the flow velocity of one cell in the wind plane, `|u| <= 1`.
     /// Needs `drag.field`.
     pub fn set_cell_wind(&mut self, pos: [u32; 3], u: [f32; 3]) -> Result<(), Error> {
-        let s = self.locate(pos)?;
-        if !self.head.desc.drag.field {
-            return Err(Error::NotEnabled);
-        }
-        finite(&u)?;
-        let d = self.dim();
-        if !slow(u[..d].iter().copied()) {
-            return Err(Error::SpeedRange);
-        }
-        self.planes::<u8>().1.wind[s.cell * d..s.cell * d + d].copy_from_slice(&u[..d]);
-        Ok(())
+        self.set_cell_vector(pos, self.head.desc.drag.field, u, true, |p| p.wind)
     }
 
     pub(crate) fn periodic(&self) -> [bool; 3] {

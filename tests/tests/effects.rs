@@ -327,37 +327,25 @@ fn the_wind_plane_refuses_what_no_flow_is_and_costs_nothing_when_off() {
         };
         let before = image(w);
         let too_fast = if dim == 2 { [0.8, 0.61, 0.0] } else { [0.6, 0.6, 0.6] };
+        use mpca::Error::{BadLength, NotFinite, OutOfBounds, SpeedRange};
         let mut calls = vec![];
-        for (at, value) in [(0, f32::NAN), (cells * d - 1, f32::INFINITY), (d, f32::NEG_INFINITY), (3, 1.01), (cells * d - 2, -1.5)] {
+        for (at, value, want) in
+            [(0, f32::NAN, NotFinite), (cells * d - 1, f32::INFINITY, NotFinite), (d, f32::NEG_INFINITY, NotFinite), (3, 1.01, SpeedRange), (cells * d - 2, -1.5, SpeedRange)]
+        {
             let mut bad = plane.clone();
             bad[at] = value;
-            calls.push((format!("plane[{at}] = {value}"), w.set_wind_field(&bad)));
+            calls.push((format!("plane[{at}] = {value}"), w.set_wind_field(&bad), want));
         }
         let mut fast = plane.clone();
         fast[d * 9..d * 10].copy_from_slice(&too_fast[..d]);
-        calls.push(("a cell of speed above 1".into(), w.set_wind_field(&fast)));
+        calls.push(("a cell of speed above 1".into(), w.set_wind_field(&fast), SpeedRange));
         for len in [0, cells * d - 1, cells * d + 1, cells] {
-            calls.push((format!("length {len}"), w.set_wind_field(&vec![0.0; len])));
+            calls.push((format!("length {len}"), w.set_wind_field(&vec![0.0; len]), BadLength));
         }
-        calls.push(("cell of speed above 1".into(), w.set_cell_wind([1, 1, 0], too_fast)));
-        calls.push(("cell wind NaN".into(), w.set_cell_wind([1, 1, 0], [0.0, f32::NAN, 0.0])));
-        calls.push(("cell outside".into(), w.set_cell_wind([8, 1, 0], [0.1, 0.0, 0.0])));
-        let wanted = [
-            mpca::Error::NotFinite,
-            mpca::Error::NotFinite,
-            mpca::Error::NotFinite,
-            mpca::Error::SpeedRange,
-            mpca::Error::SpeedRange,
-            mpca::Error::SpeedRange,
-            mpca::Error::BadLength,
-            mpca::Error::BadLength,
-            mpca::Error::BadLength,
-            mpca::Error::BadLength,
-            mpca::Error::SpeedRange,
-            mpca::Error::NotFinite,
-            mpca::Error::OutOfBounds,
-        ];
-        for ((what, got), want) in calls.into_iter().zip(wanted) {
+        calls.push(("cell of speed above 1".into(), w.set_cell_wind([1, 1, 0], too_fast), SpeedRange));
+        calls.push(("cell wind NaN".into(), w.set_cell_wind([1, 1, 0], [0.0, f32::NAN, 0.0]), NotFinite));
+        calls.push(("cell outside".into(), w.set_cell_wind([8, 1, 0], [0.1, 0.0, 0.0]), OutOfBounds));
+        for (what, got, want) in calls {
             assert_eq!(got, Err(want), "{dim}D {what}");
         }
         assert!(image(w) == before, "{dim}D: a refused call changed the world");
