@@ -634,6 +634,18 @@ typedef struct mpca_desc {
    * 1: the vortex (`vortex_*`) read as a velocity field adds to the flow.
    */
   uint32_t drag_vortex;
+  /**
+   * 1: a flow velocity per cell adds to the flow (the wind plane, `dim`
+   * floats a cell, zero until mpca_world_set_wind_field or
+   * mpca_world_set_cell_wind sets it).
+   */
+  uint32_t drag_wind_field;
+  /**
+   * 0: room a later version may give a meaning, so that the structure
+   * has no padding (whole structures compare with memcmp). Anything
+   * else is refused with MPCA_STATUS_BAD_ENUM.
+   */
+  uint32_t reserved;
 } mpca_desc;
 
 /**
@@ -920,6 +932,23 @@ mpca_status mpca_world_set_vortex(struct mpca_world *world,
                                   float cy,
                                   float core_radius,
                                   float circulation);
+
+/**
+ * Replaces the wind plane (M5.1b): `dim` flow velocity components per
+ * cell, cells x fastest; `len` must be `dim` times the cell count. Every
+ * value finite (`MPCA_STATUS_NOT_FINITE`) and every cell's speed at most 1
+ * (`MPCA_STATUS_SPEED_RANGE`), else nothing is set. Needs
+ * `mpca_desc.drag_wind_field`.
+ */
+mpca_status mpca_world_set_wind_field(struct mpca_world *world, const float *wind, size_t len);
+
+/**
+ * Sets the flow velocity (3 values, speed at most 1) of the cell at `pos`
+ * in the wind plane (M5.1b).
+ */
+mpca_status mpca_world_set_cell_wind(struct mpca_world *world,
+                                     const uint32_t *pos,
+                                     const float *wind);
 
 /**
  * Makes the cell at `pos` an obstacle with outward `normal` (3 values,

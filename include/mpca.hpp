@@ -312,6 +312,16 @@ public:
     /** The uniform acceleration (mpca_world_set_gravity). */
     void set_gravity(const vec3 &g) { check(mpca_world_set_gravity(w_, g.data())); }
 
+    /** Replaces the wind plane of the flow drag (M5.1b): dim flow velocity
+     * components per cell, x fastest, each cell's speed at most 1
+     * (mpca_world_set_wind_field). */
+    void set_wind_field(const std::vector<float> &wind) {
+        check(mpca_world_set_wind_field(w_, wind.data(), wind.size()));
+    }
+
+    /** The flow velocity of one cell in the wind plane (mpca_world_set_cell_wind). */
+    void set_cell_wind(const cell_pos &pos, const vec3 &u) { check(mpca_world_set_cell_wind(w_, pos.data(), u.data())); }
+
     /** Obstacle cells with centres in the box min <= c <= max. */
     void add_box(const vec3 &min, const vec3 &max, float e) {
         check(mpca_world_add_box(w_, min.data(), max.data(), e));

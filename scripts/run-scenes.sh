@@ -139,7 +139,7 @@ if [ "$docs" -eq 1 ]; then
         smoke) echo "one particle a step rises from the ground and the vortex (grey guides) bends the plume;";;
         water) echo "water poured on the sphere splashes off it and spreads over the floor;";;
         smoke-long) echo "the same smoke for 480 steps: the vortex bends the plume round its right side and flings it out at the top right;";;
-        smoke-flow) echo "the smoke as buoyancy plus drag towards the vortex's flow, 1,200 steps: it rises at its terminal speed (slow colours, no clamp) and is carried up round the vortex's right side instead of being flung out; it does not wind into the core, since its rise (0.08 cells a step) is over half the flow's speed at the core (0.14). Its density, in bins of 8 × 8 cells, is drawn as grey haze under the particles.";;
+        smoke-flow) echo "the smoke as buoyancy plus drag towards the air's flow, 1,200 steps. The air is a vortex fed through its core (the vortex's flow plus an inflow of the same profile, set per cell in the wind plane), so its streamlines spiral in: the plume rises at its terminal speed (slow colours, no clamp), winds up round the vortex's right side and over it into the core, and gathers there (22 % of the particles within 1.5 core radii at the end, against 1 % when the flow is the vortex's alone and the plume passes its side). Its density, in bins of 8 × 8 cells, is drawn as grey haze under the particles.";;
         water-pool) echo "a block of 9,216 particles released above the sphere under gravity 0.002, e = 0.5 and contacts on: it splashes off the sphere and, by step 1,000, lies as a pool on the floor (mean speed 0.07, no clamp), where the paper's rules (e = 1, no contacts) keep it bouncing round the box.";;
     esac; }
     # 12345 -> 12,345

@@ -57,16 +57,20 @@ pub enum Collisions {
 /// M5.1b flow drag (beyond the paper): after the forces of M5.1, each
 /// velocity relaxes towards the flow velocity `u` at its cell at `rate` per
 /// unit time, `v <- (v + dt rate u) / (1 + dt rate)` (backward Euler: stable
-/// for any `dt rate`, never past `u`). The flow is `wind` plus, if `vortex`,
-/// the Rankine vortex of the description read as a velocity field
-/// (`G r / (2 pi R^2)` inside the core, `G / (2 pi r)` outside, tangential).
-/// A rate of 0 is off. Needs the `fields` feature.
+/// for any `dt rate`, never past `u`). The flow is `wind` plus, if `field`,
+/// the cell's value in the wind plane ([`crate::World::set_wind_field`]),
+/// plus, if `vortex`, the Rankine vortex of the description read as a
+/// velocity field (`G r / (2 pi R^2)` inside the core, `G / (2 pi r)`
+/// outside, tangential). A rate of 0 is off. Needs the `fields` feature.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Drag {
     /// The relaxation rate per unit time, finite and not negative.
     pub rate: f32,
     /// A uniform flow velocity, `|wind| <= 1`.
     pub wind: [f32; 3],
+    /// Add a flow velocity per cell to the flow: a plane of `dim` `f32` per
+    /// cell, each cell's `|u| <= 1`, zero until set.
+    pub field: bool,
     /// Add the vortex's velocity field to the flow.
     pub vortex: bool,
 }
@@ -197,7 +201,7 @@ impl Description {
             seed: 0,
             quantization: Quantization::Bits8,
             drift: Drift::Calibrated,
-            drag: Drag { rate: 0.0, wind: [0.0; 3], vortex: false },
+            drag: Drag { rate: 0.0, wind: [0.0; 3], field: false, vortex: false },
             method: Method::ExactFast,
             collisions: Collisions::Paper,
             contacts: false,

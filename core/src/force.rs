@@ -1,8 +1,10 @@
 //! External forces (M5.1, eqs. 4-6): `v <- v + dt F / m`, with `F` the sum of
 //! the terms the description enables. A uniform acceleration is the same for
 //! every mass; the other terms are forces, divided by the particle's mass.
+//! And the flow that drag relaxes velocities towards (M5.1b).
 
 use crate::desc::{finite, Boundary, Vortex};
+use crate::layout::Planes;
 use crate::world::World;
 use crate::Error;
 
@@ -67,6 +69,40 @@ impl ForceTerms<'_> {
             stride *= n;
         }
         g
+    }
+}
+
+/// The flow of M5.1b drag, read-only, for the general path: `u` at a cell
+/// is the uniform wind, plus the wind plane's value there, plus the vortex
+/// read as a velocity, in quanta per step.
+pub(crate) struct Flow<'a> {
+    /// The uniform wind, in quanta.
+    pub wind: [f32; 3],
+    pub field: Option<&'a [f32]>,
+    pub vortex: Option<Vortex>,
+    /// Quanta per unit speed.
+    pub scale: f32,
+    pub dim: usize,
+    /// `dt * rate`.
+    pub rate: f32,
+}
+
+impl Flow<'_> {
+    /// The flow at cell `pos` (dense index `cell`), in quanta.
+    #[inline]
+    pub fn at(&self, pos: [usize; 3], cell: usize) -> [f32; 3] {
+        let mut u = self.wind;
+        if let Some(field) = self.field {
+            for k in 0..self.dim {
+                u[k] += field[cell * self.dim + k] * self.scale;
+            }
+        }
+        if let Some(v) = self.vortex {
+            let t = vortex_force(&v, [pos[0] as f32 + 0.5, pos[1] as f32 + 0.5]);
+            u[0] += t[0] * self.scale;
+            u[1] += t[1] * self.scale;
+        }
+        u
     }
 }
 
@@ -136,13 +172,31 @@ impl World {
 
     /// Sets the force on one cell. Needs `forces.field`.
     pub fn set_cell_force(&mut self, pos: [u32; 3], f: [f32; 3]) -> Result<(), Error> {
+        self.set_cell_vector(pos, self.head.desc.forces.field, f, false, |p| p.field)
+    }
+
+    /// Writes the first `dim` components of `v` at the cell `pos` of a
+    /// plane of `dim` floats a cell, which `plane` picks, after the checks
+    /// such a setter makes: a cell of the world, a plane the world has
+    /// (`enabled`), finite values and, for a velocity, a speed of at most 1.
+    fn set_cell_vector(
+        &mut self,
+        pos: [u32; 3],
+        enabled: bool,
+        v: [f32; 3],
+        velocity: bool,
+        plane: fn(Planes<'_, u8>) -> &mut [f32],
+    ) -> Result<(), Error> {
         let s = self.locate(pos)?;
-        if !self.head.desc.forces.field {
+        if !enabled {
             return Err(Error::NotEnabled);
         }
-        finite(&f)?;
+        finite(&v)?;
         let d = self.dim();
-        self.planes::<u8>().1.field[s.cell * d..s.cell * d + d].copy_from_slice(&f[..d]);
+        if velocity && !slow(v[..d].iter().copied()) {
+            return Err(Error::SpeedRange);
+        }
+        plane(self.planes::<u8>().1)[s.cell * d..s.cell * d + d].copy_from_slice(&v[..d]);
         Ok(())
     }
 
@@ -165,10 +219,35 @@ impl World {
         Ok(())
     }
 
+    /// Replaces the wind plane of M5.1b: `dim` flow velocity components per
+    /// cell, cells in dense order (x fastest). Each cell's `|u|` must be at
+    /// most 1 (`SpeedRange`); the sum with the uniform wind and the vortex
+    /// is not bounded, the clamp (M5.5) is. Needs `drag.field`.
+    pub fn set_wind_field(&mut self, wind: &[f32]) -> Result<(), Error> {
+        let d = self.dim();
+        self.force_plane_check(self.head.desc.drag.field, wind, d)?;
+        if wind.chunks_exact(d).any(|u| !slow(u.iter().copied())) {
+            return Err(Error::SpeedRange);
+        }
+        self.planes::<u8>().1.wind.copy_from_slice(wind);
+        Ok(())
+    }
+
+    /// Sets the flow velocity of one cell in the wind plane, `|u| <= 1`.
+    /// Needs `drag.field`.
+    pub fn set_cell_wind(&mut self, pos: [u32; 3], u: [f32; 3]) -> Result<(), Error> {
+        self.set_cell_vector(pos, self.head.desc.drag.field, u, true, |p| p.wind)
+    }
+
     pub(crate) fn periodic(&self) -> [bool; 3] {
         let b = self.head.desc.boundary;
         [0, 1, 2].map(|k| b[k][0] == Boundary::Periodic)
     }
+}
+
+/// A velocity no faster than 1 (M1), in the components given.
+pub(crate) fn slow(u: impl IntoIterator<Item = f32>) -> bool {
+    u.into_iter().map(|c| c * c).sum::<f32>() <= 1.0
 }
 
 #[cfg(test)]

@@ -42,8 +42,8 @@
 use crate::assign::{assign_moves, bits, optimal_moves_2d, pick_move, Bits, Method, MoveProblem, PLACE_2D};
 use crate::cells::Cells;
 use crate::collision::{collide_limited, collide_pair, energy_neutral, pick_pair, random_unit, shares};
-use crate::desc::{Collisions, Description, Vortex};
-use crate::force::{vortex_force, ForceTerms};
+use crate::desc::{Collisions, Description};
+use crate::force::{Flow, ForceTerms};
 use crate::obstacle::{reflect, surface_at, Surface};
 use crate::partition::{cells_at, resolve, BlockRow, BlockSink, Beyond, Index, Partition};
 use crate::quant::Quant;
@@ -67,9 +67,8 @@ pub(crate) struct Shared<'a> {
     pub push: Option<[f32; 3]>,
     /// `dt * SCALE`: turns an acceleration into quanta per step.
     pub dt_q: f32,
-    /// M5.1b flow drag, where its rate is not 0: the uniform wind in
-    /// quanta, the vortex read as a velocity, and `dt * rate`.
-    pub drag: Option<([f32; 3], Option<Vortex>, f32)>,
+    /// M5.1b flow drag, where its rate is not 0.
+    pub drag: Option<Flow<'a>>,
     /// The 8-bit move table of the drift rule (M5.3).
     pub moves: &'static [u16; 256],
     /// Forces other than a uniform one (fields, potentials, the vortex,
@@ -951,15 +950,10 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
         }
 
         // M5.1b flow drag: v <- (v + a u) / (1 + a), u the flow at the cell.
-        if let Some((wind, vortex, a)) = sh.drag {
+        if let Some(flow) = &sh.drag {
+            let a = flow.rate;
             for c in cells_of(occ) {
-                let mut u = wind;
-                if let Some(v) = vortex {
-                    let pos = sh.part.cell_coords(row, [xs[c & 1], 0, 0], c);
-                    let t = vortex_force(&v, [pos[0] as f32 + 0.5, pos[1] as f32 + 0.5]);
-                    u[0] += t[0] * Q::SCALE;
-                    u[1] += t[1] * Q::SCALE;
-                }
+                let u = flow.at(sh.part.cell_coords(row, [xs[c & 1], 0, 0], c), cell(c));
                 let mut x = b.velocity(c);
                 for k in 0..D {
                     x[k] = (x[k] + a * u[k]) / (1.0 + a);

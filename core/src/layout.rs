@@ -90,6 +90,8 @@ pub(crate) struct Layout {
     pub life: Plane,
     pub field: Plane,
     pub potential: Plane,
+    /// The wind plane of M5.1b, `dim` `f32` per cell.
+    pub wind: Plane,
     pub mass_table: Plane,
     pub surface: Plane,
     pub emitters: Plane,
@@ -142,8 +144,7 @@ impl Layout {
         if d.drag.rate < 0.0 {
             return Err(Error::BadDrag);
         }
-        let w = &d.drag.wind[..dim];
-        if w.iter().map(|c| c * c).sum::<f32>() > 1.0 {
+        if !crate::force::slow(d.drag.wind[..dim].iter().copied()) {
             return Err(Error::SpeedRange);
         }
         if d.drag.vortex && d.drag.rate > 0.0 && d.vortex.core_radius <= 0.0 {
@@ -154,7 +155,7 @@ impl Layout {
         }
         if (d.per_particle_mass && !cfg!(feature = "mass"))
             || (d.obstacles && !cfg!(feature = "obstacles"))
-            || ((d.forces.any_field() || d.drag.rate > 0.0) && !cfg!(feature = "fields"))
+            || ((d.forces.any_field() || d.drag.rate > 0.0 || d.drag.field) && !cfg!(feature = "fields"))
         {
             return Err(Error::FeatureDisabled);
         }
@@ -190,6 +191,7 @@ impl Layout {
         let life = b.plane(per_cell(2, d.lifetimes)?)?;
         let field = b.plane(per_cell(dim * 4, d.forces.field)?)?;
         let potential = b.plane(per_cell(4, d.forces.potential)?)?;
+        let wind = b.plane(per_cell(dim * 4, d.drag.field)?)?;
         let mass_table = b.plane(if d.per_particle_mass { d.mass_classes as usize * 4 } else { 0 })?;
         let surface_len = if d.obstacles {
             (d.surface_capacity as usize).checked_mul(core::mem::size_of::<crate::obstacle::Surface>()).ok_or(Error::TooLarge)?
@@ -214,6 +216,7 @@ impl Layout {
             life,
             field,
             potential,
+            wind,
             mass_table,
             surface,
             emitters,
@@ -250,6 +253,7 @@ pub(crate) struct Planes<'a, Q> {
     pub life: &'a mut [u16],
     pub field: &'a mut [f32],
     pub potential: &'a mut [f32],
+    pub wind: &'a mut [f32],
     pub mass_table: &'a mut [f32],
     pub surface: &'a mut [Surface],
     pub emitters: &'a mut [Slot],

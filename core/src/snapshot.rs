@@ -221,6 +221,7 @@ fn image_len(d: &Description, l: &Layout, particles: usize, masses: usize, surfa
         particles.checked_mul(per_particle)?,
         l.field.len,
         l.potential.len,
+        l.wind.len,
         masses.checked_mul(4)?,
         surfaces.checked_mul(SURFACE)?,
         emitters.checked_mul(EMITTER)?,
@@ -261,7 +262,7 @@ fn put_desc(p: &mut Put<'_>, d: &Description) {
     } = *d;
     let Forces { uniform, field, potential, vortex: swirl } = forces;
     let Vortex { centre, core_radius, circulation } = vortex;
-    let Drag { rate, wind, vortex: flow } = drag;
+    let Drag { rate, wind, field: wind_plane, vortex: flow } = drag;
     p.u32(dim);
     size.iter().for_each(|&s| p.u32(s));
     p.u64(seed);
@@ -288,7 +289,11 @@ fn put_desc(p: &mut Put<'_>, d: &Description) {
     p.f32(dt);
     p.f32(rate);
     wind.iter().for_each(|&w| p.f32(w));
-    p.bytes(&[0; 4]);
+    // The first of what were four reserved zero bytes: an image of a world
+    // without a wind plane is the one an older library wrote, and an older
+    // library refuses an image with one.
+    p.u8(u8::from(wind_plane));
+    p.bytes(&[0; 3]);
 }
 
 fn get_desc(g: &mut Get<'_>) -> Result<Description, Error> {
@@ -334,8 +339,9 @@ fn get_desc(g: &mut Get<'_>) -> Result<Description, Error> {
     let gravity = [g.f32()?, g.f32()?, g.f32()?];
     let vortex = Vortex { centre: [g.f32()?, g.f32()?], core_radius: g.f32()?, circulation: g.f32()? };
     let (restitution, wall_restitution, dt) = (g.f32()?, g.f32()?, g.f32()?);
-    let drag = Drag { rate: g.f32()?, wind: [g.f32()?, g.f32()?, g.f32()?], vortex: flow };
-    g.zeros(4)?;
+    let (rate, wind) = (g.f32()?, [g.f32()?, g.f32()?, g.f32()?]);
+    let drag = Drag { rate, wind, field: g.flag()?, vortex: flow };
+    g.zeros(3)?;
     Ok(Description {
         dim,
         size,
@@ -418,6 +424,7 @@ struct Image<'a> {
     life: &'a [u8],
     field: &'a [u8],
     potential: &'a [u8],
+    wind: &'a [u8],
     mass_table: &'a [u8],
     surface: &'a [u8],
     emitter: &'a [u8],
@@ -504,6 +511,7 @@ fn read(image: &[u8]) -> Result<Image<'_>, Error> {
         life: g.take(if desc.lifetimes { 2 * n } else { 0 })?,
         field: g.take(layout.field.len)?,
         potential: g.take(layout.potential.len)?,
+        wind: g.take(layout.wind.len)?,
         mass_table: g.take(4 * masses)?,
         surface: g.take(SURFACE * surfaces)?,
         emitter: g.take(EMITTER * emitters)?,
@@ -549,9 +557,14 @@ fn check(img: &Image<'_>) -> Result<(), Error> {
         return bad;
     }
 
-    // Force planes: finite, as the set functions require.
-    let floats = |plane: &[u8]| (0..plane.len() / 4).all(|i| f32::from_bits(le_u32(plane, i)).is_finite());
-    if !floats(img.field) || !floats(img.potential) {
+    // Force and wind planes: finite, as the set functions require, and no
+    // cell's wind faster than 1.
+    let float = |plane: &[u8], i: usize| f32::from_bits(le_u32(plane, i));
+    let floats = |plane: &[u8]| (0..plane.len() / 4).all(|i| float(plane, i).is_finite());
+    if !floats(img.field) || !floats(img.potential) || !floats(img.wind) {
+        return bad;
+    }
+    if !(0..img.wind.len() / 4).step_by(dim).all(|i| crate::force::slow((i..i + dim).map(|k| float(img.wind, k)))) {
         return bad;
     }
 
@@ -651,11 +664,10 @@ fn apply(w: &mut World, img: &Image<'_>) {
             }
             i += 1;
         });
-        for (k, f) in p.field.iter_mut().enumerate() {
-            *f = f32::from_bits(le_u32(img.field, k));
-        }
-        for (k, u) in p.potential.iter_mut().enumerate() {
-            *u = f32::from_bits(le_u32(img.potential, k));
+        for (plane, bytes) in [(p.field, img.field), (p.potential, img.potential), (p.wind, img.wind)] {
+            for (k, f) in plane.iter_mut().enumerate() {
+                *f = f32::from_bits(le_u32(bytes, k));
+            }
         }
         p.mass_table.fill(0.0);
         for (k, m) in p.mass_table.iter_mut().take(img.masses).enumerate() {
@@ -682,7 +694,7 @@ pub fn image_description(image: &[u8]) -> Result<Description, Error> {
 impl World {
     /// Bytes of the image [`World::save`] writes now: a fixed 248 bytes,
     /// the occupancy and obstacle bit planes, a few bytes per particle,
-    /// the force planes, and the used entries of the tables (M12).
+    /// the force and wind planes, and the used entries of the tables (M12).
     pub fn snapshot_bytes(&self) -> usize {
         let h = &self.head;
         let occupancy: &[u64] = self.plane(h.layout.occupancy);
@@ -742,6 +754,7 @@ impl World {
         }
         self.plane::<f32>(l.field).iter().for_each(|&f| p.f32(f));
         self.plane::<f32>(l.potential).iter().for_each(|&u| p.f32(u));
+        self.plane::<f32>(l.wind).iter().for_each(|&u| p.f32(u));
         self.plane::<f32>(l.mass_table)[..h.masses as usize].iter().for_each(|&m| p.f32(m));
         self.plane::<Surface>(l.surface)[..h.surfaces as usize].iter().for_each(|s| put_surface(&mut p, s));
         self.plane::<Slot>(l.emitters)[..h.emitters as usize].iter().for_each(|s| put_slot(&mut p, s));
@@ -752,13 +765,14 @@ impl World {
     }
 
     /// Makes this world the one `image` holds (M12): its description,
-    /// step number, counters, particles, obstacles, force planes and tables,
+    /// step number, counters, particles, obstacles, force and wind planes
+    /// and tables,
     /// so that it hashes equal to the saved world and steps on exactly as
     /// that world would have.
     ///
     /// This world must have the image's plan of memory: the same sizes,
     /// velocity width and parts (obstacles, per-particle masses, lifetimes,
-    /// force field, potential) and the same capacities (mass classes,
+    /// force field, potential, wind plane) and the same capacities (mass classes,
     /// surface and emitter tables); anything else is refused with
     /// `ImageMismatch`. What does not change the plan (seed, forces,
     /// restitutions, method, faces...) is taken from the image. A world built

@@ -10,7 +10,7 @@
 
 use crate::cells::Cells;
 use crate::layout::Layout;
-use crate::force::ForceTerms;
+use crate::force::{Flow, ForceTerms};
 use crate::kernel::{Kernel, Shared, Writable};
 use crate::partition::Partition;
 use crate::quant::Quant;
@@ -161,7 +161,7 @@ impl World {
         let (head, p) = self.planes::<Q>();
         let desc = head.desc;
         let Layout { n, .. } = head.layout;
-        let Planes { occupancy, rows, words, obstacle, velocity, mass_index, life, field, potential, mass_table, surface, .. } = p;
+        let Planes { occupancy, rows, words, obstacle, velocity, mass_index, life, field, potential, wind, mass_table, surface, .. } = p;
         let terms = ForceTerms {
             gravity: if desc.forces.uniform { desc.gravity } else { [0.0; 3] },
             field: desc.forces.field.then_some(&*field),
@@ -188,9 +188,13 @@ impl World {
             push: (push != [0.0; 3]).then_some(push),
             terms,
             dt_q,
-            drag: (desc.drag.rate > 0.0).then(|| {
-                let wind = desc.drag.wind.map(|w| w * Q::SCALE);
-                (wind, desc.drag.vortex.then_some(desc.vortex), desc.dt * desc.drag.rate)
+            drag: (desc.drag.rate > 0.0).then(|| Flow {
+                wind: desc.drag.wind.map(|w| w * Q::SCALE),
+                field: desc.drag.field.then_some(&*wind),
+                vortex: desc.drag.vortex.then_some(desc.vortex),
+                scale: Q::SCALE,
+                dim,
+                rate: desc.dt * desc.drag.rate,
             }),
             moves: crate::quant::move_table_8(desc.drift),
             summed,

@@ -223,6 +223,7 @@ impl World {
             life: view(take(l.life)),
             field: view(take(l.field)),
             potential: view(take(l.potential)),
+            wind: view(take(l.wind)),
             mass_table: view(take(l.mass_table)),
             surface: view(take(l.surface)),
             emitters: view(take(l.emitters)),

@@ -132,6 +132,14 @@ pub struct mpca_desc {
     pub drag_wind: [f32; 3],
     /// 1: the vortex (`vortex_*`) read as a velocity field adds to the flow.
     pub drag_vortex: u32,
+    /// 1: a flow velocity per cell adds to the flow (the wind plane, `dim`
+    /// floats a cell, zero until mpca_world_set_wind_field or
+    /// mpca_world_set_cell_wind sets it).
+    pub drag_wind_field: u32,
+    /// 0: room a later version may give a meaning, so that the structure
+    /// has no padding (whole structures compare with memcmp). Anything
+    /// else is refused with MPCA_STATUS_BAD_ENUM.
+    pub reserved: u32,
 }
 
 const FORCE_BITS: u32 = mpca_force::Uniform as u32 | mpca_force::Field as u32 | mpca_force::Potential as u32 | mpca_force::Vortex as u32;
@@ -194,6 +202,8 @@ impl mpca_desc {
             drag_rate: d.drag.rate,
             drag_wind: d.drag.wind,
             drag_vortex: u32::from(d.drag.vortex),
+            drag_wind_field: u32::from(d.drag.field),
+            reserved: 0,
         }
     }
 
@@ -201,7 +211,7 @@ impl mpca_desc {
     /// here, everything else by the core's own validation.
     pub(crate) fn to_core(self) -> Result<Description, mpca_status> {
         check_size::<mpca_desc>(self.struct_size)?;
-        if self.forces & !FORCE_BITS != 0 {
+        if self.forces & !FORCE_BITS != 0 || self.reserved != 0 {
             return Err(mpca_status::BadEnum);
         }
         let mut d = if self.dim == 3 { Description::new_3d(1, 1, 1) } else { Description::new_2d(1, 1) };
@@ -252,7 +262,7 @@ impl mpca_desc {
         };
         d.contacts = flag(self.contacts)?;
         d.energy_neutral = flag(self.energy_neutral)?;
-        d.drag = Drag { rate: self.drag_rate, wind: self.drag_wind, vortex: flag(self.drag_vortex)? };
+        d.drag = Drag { rate: self.drag_rate, wind: self.drag_wind, field: flag(self.drag_wind_field)?, vortex: flag(self.drag_vortex)? };
         d.emitter_capacity = self.emitter_capacity;
         d.lifetimes = flag(self.lifetimes)?;
         Ok(d)

@@ -1,6 +1,7 @@
 //! Forces (M5.1): the uniform acceleration, the per-cell field, the
 //! potential and the Rankine vortex. Each needs its bit in
-//! `mpca_desc.forces`, else `MPCA_STATUS_NOT_ENABLED`.
+//! `mpca_desc.forces`, else `MPCA_STATUS_NOT_ENABLED`. And the wind plane
+//! of the flow drag (M5.1b), which needs `mpca_desc.drag_wind_field`.
 
 use mpca_core::Vortex;
 
@@ -61,5 +62,29 @@ pub unsafe extern "C" fn mpca_world_set_vortex(world: *mut mpca_world, cx: f32, 
     guard(|c| {
         let w = c.world(world)?;
         Ok(w.set_vortex(Vortex { centre: [cx, cy], core_radius, circulation })?)
+    })
+}
+
+/// Replaces the wind plane (M5.1b): `dim` flow velocity components per
+/// cell, cells x fastest; `len` must be `dim` times the cell count. Every
+/// value finite (`MPCA_STATUS_NOT_FINITE`) and every cell's speed at most 1
+/// (`MPCA_STATUS_SPEED_RANGE`), else nothing is set. Needs
+/// `mpca_desc.drag_wind_field`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mpca_world_set_wind_field(world: *mut mpca_world, wind: *const f32, len: usize) -> mpca_status {
+    guard(|c| {
+        let w = c.world(world)?;
+        Ok(w.set_wind_field(c.slice(wind, len, mpca_status::BadLength)?)?)
+    })
+}
+
+/// Sets the flow velocity (3 values, speed at most 1) of the cell at `pos`
+/// in the wind plane (M5.1b).
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mpca_world_set_cell_wind(world: *mut mpca_world, pos: *const u32, wind: *const f32) -> mpca_status {
+    guard(|c| {
+        let w = c.world(world)?;
+        let (pos, u) = (c.array(pos)?, c.array(wind)?);
+        Ok(w.set_cell_wind(pos, u)?)
     })
 }

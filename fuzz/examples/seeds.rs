@@ -56,6 +56,7 @@ fn descriptions() -> Vec<mpca_desc> {
     d.energy_neutral = 1;
     d.drag_rate = 0.5;
     d.drag_wind = [0.1, 0.0, 0.0];
+    d.drag_wind_field = 1;
     d.method = 2;
     all.push(d);
     all
@@ -92,6 +93,9 @@ fn furnished(d: &mpca_desc, bytes: &mut Bytes) -> World {
     }
     if d.forces & 4 != 0 {
         w.set_cell_potential([2, 1, 0], 0.05).expect("a potential");
+    }
+    if d.drag_wind_field == 1 {
+        w.set_cell_wind([1, 0, 0], [0.0, 0.3, 0.0]).expect("a wind");
     }
     w.step(3).expect("steps");
     w

@@ -1,4 +1,4 @@
-//! Description validation, by both doors: the input's first 168 bytes as a
+//! Description validation, by both doors: the input's first 176 bytes as a
 //! C `mpca_desc` (any field any value), and the same bytes read into the
 //! core's `Description`, each field brought near its range so validation
 //! runs deep. Checked: nothing panics; the C door refuses exactly what the
@@ -53,6 +53,7 @@ fn core_desc(c: &mpca_desc) -> Description {
     d.drag.rate = c.drag_rate;
     d.drag.wind = c.drag_wind;
     d.drag.vortex = c.drag_vortex & 1 == 1;
+    d.drag.field = c.drag_wind_field & 1 == 1;
     d
 }
 
@@ -88,6 +89,7 @@ fn to_c(d: &Description) -> mpca_desc {
     c.drag_rate = d.drag.rate;
     c.drag_wind = d.drag.wind;
     c.drag_vortex = u32::from(d.drag.vortex);
+    c.drag_wind_field = u32::from(d.drag.field);
     c
 }
 

@@ -156,7 +156,7 @@ fuzz_target!(|data: &[u8]| {
             break;
         }
         let before = (w.save(), w.hash());
-        let op = input.pick(20);
+        let op = input.pick(22);
         let result: Result<(), mpca_status> = match op {
             0 | 1 => {
                 let (pos, v) = (input.position(n), input.vector());
@@ -299,6 +299,14 @@ fuzz_target!(|data: &[u8]| {
                 }
                 r.map(|_| ())
             }
+            19 => {
+                // Winds near the speed limit of 1, now and then past it or
+                // not finite: refused whole.
+                let len = if input.bit() { m.cells * m.dim } else { input.pick(m.cells * m.dim + 2) };
+                let u: Vec<f32> = (0..len).map(|i| if i % 3 == 0 { input.value() * 0.8 } else { 0.0 }).collect();
+                w.set_wind_field(&u)
+            }
+            20 => w.set_cell_wind(input.position(n), input.vector().map(|u| u * 0.8)),
             _ => Err(w.refused_calls(input.u8() as usize)),
         };
         if result.is_err() {

@@ -137,6 +137,7 @@ pub fn scene(input: &mut Input<'_>) -> mpca_desc {
     d.drag_rate = [0.0, 0.0, 0.1, 1.0][input.pick(4)];
     d.drag_wind = input.vector().map(|w| w / 2.0);
     d.drag_vortex = u32::from(parts & 256 != 0);
+    d.drag_wind_field = u32::from(parts & 512 != 0);
     d
 }
 
@@ -183,6 +184,8 @@ fn desc_words(d: &mut mpca_desc, each: &mut dyn FnMut(&mut u32)) {
         float(f, each);
     }
     each(&mut d.drag_vortex);
+    each(&mut d.drag_wind_field);
+    each(&mut d.reserved);
 }
 
 /// An `mpca_desc` from the input, every field any value.
@@ -413,6 +416,16 @@ impl World {
         status(unsafe { mpca_world_set_cell_force(self.handle, pos.as_ptr(), f.as_ptr()) })
     }
 
+    pub fn set_wind_field(&mut self, u: &[f32]) -> Result<(), mpca_status> {
+        // SAFETY: a live handle and the slice's floats.
+        status(unsafe { mpca_world_set_wind_field(self.handle, u.as_ptr(), u.len()) })
+    }
+
+    pub fn set_cell_wind(&mut self, pos: [u32; 3], u: [f32; 3]) -> Result<(), mpca_status> {
+        // SAFETY: a live handle and two arrays of 3.
+        status(unsafe { mpca_world_set_cell_wind(self.handle, pos.as_ptr(), u.as_ptr()) })
+    }
+
     pub fn set_potential(&mut self, u: &[f32]) -> Result<(), mpca_status> {
         // SAFETY: a live handle and the slice's floats.
         status(unsafe { mpca_world_set_potential(self.handle, u.as_ptr(), u.len()) })
@@ -497,7 +510,7 @@ impl World {
         // SAFETY: every pointer is NULL or a live local; the forged handle
         // is refused by the registry before anything is read.
         let (s, want) = unsafe {
-            match which % 6 {
+            match which % 7 {
                 0 => (mpca_world_add_particle(self.handle, null(), v.as_ptr()), mpca_status::NullPointer),
                 1 => (mpca_world_add_particle(self.handle, pos.as_ptr(), null()), mpca_status::NullPointer),
                 2 => {
@@ -506,6 +519,7 @@ impl World {
                 }
                 3 => (mpca_world_step(self.handle.wrapping_byte_add(8), 1), mpca_status::BadHandle),
                 4 => (mpca_world_set_force_field(self.handle, null(), 0), mpca_status::NullPointer),
+                5 => (mpca_world_set_wind_field(self.handle, null(), 0), mpca_status::NullPointer),
                 _ => (mpca_world_remove_particle(self.handle, pos.as_ptr(), null_mut()), mpca_status::NullPointer),
             }
         };

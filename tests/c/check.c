@@ -45,6 +45,8 @@ static const struct symbol {
     SYMBOL(mpca_world_set_potential),
     SYMBOL(mpca_world_set_cell_potential),
     SYMBOL(mpca_world_set_vortex),
+    SYMBOL(mpca_world_set_wind_field),
+    SYMBOL(mpca_world_set_cell_wind),
     SYMBOL(mpca_world_add_obstacle),
     SYMBOL(mpca_world_add_half_space),
     SYMBOL(mpca_world_add_box),

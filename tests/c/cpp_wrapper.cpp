@@ -162,6 +162,7 @@ static void errors() {
     THROWS(MPCA_STATUS_NOT_ENABLED, w.add_disc(16.0f, 16.0f, 4.0f, 1.0f)); /* no obstacles in this world */
     THROWS(MPCA_STATUS_OUT_OF_BOUNDS, w.set_emitter_rate(0, 1.0f)); /* no emitter 0 */
     THROWS(MPCA_STATUS_BAD_EMITTER, w.set_emitter_rate(0, -1.0f));
+    THROWS(MPCA_STATUS_NOT_ENABLED, w.set_cell_wind({1, 1, 0}, {0.1f, 0.0f, 0.0f})); /* no wind plane */
     CHECK(w.hash() == before);
 
     /* Caught as what it derives from, too. */
@@ -278,6 +279,25 @@ static void same_as_c() {
     mpca::world s(d3);
     s.add_sphere({8.0f, 8.0f, 8.0f}, 3.0f, 1.0f);
     CHECK(s.cell({8, 8, 8}).kind == MPCA_CELL_KIND_OBSTACLE && std::strcmp(mpca::version(), mpca_version()) == 0);
+
+    /* The wind plane (M5.1b): a particle at rest in a wind of (0.5, 0)
+     * with drag k = 1 moves off along +x; a wind too fast is refused. */
+    mpca_desc dw = mpca::desc_2d(16, 16);
+    dw.drag_rate = 1.0f;
+    dw.drag_wind_field = 1;
+    mpca::world wind(dw);
+    std::vector<float> plane(16 * 16 * 2, 0.0f);
+    for (std::size_t i = 0; i < plane.size(); i += 2) plane[i] = 0.5f;
+    wind.set_wind_field(plane);
+    wind.add_particle({8, 8, 0}, {0.0f, 0.0f, 0.0f});
+    wind.set_cell_wind({8, 8, 0}, {0.5f, 0.0f, 0.0f});
+    const std::uint64_t calm = wind.hash();
+    plane[7] = 1.5f;
+    THROWS(MPCA_STATUS_SPEED_RANGE, wind.set_wind_field(plane));
+    THROWS(MPCA_STATUS_SPEED_RANGE, wind.set_cell_wind({8, 8, 0}, {0.0f, -1.01f, 0.0f}));
+    CHECK(wind.hash() == calm);
+    wind.step(1);
+    CHECK(wind.velocities()[0] > 0.2f);
     std::printf("cpp: same as C\n");
 }
 

@@ -19,7 +19,7 @@
 #include "check.h"
 
 /* The layout ffi/src/lib.rs asserts on the Rust side. */
-STATIC_ASSERT(sizeof(mpca_desc) == 168 && ALIGNOF(mpca_desc) == 8, "mpca_desc layout");
+STATIC_ASSERT(sizeof(mpca_desc) == 176 && ALIGNOF(mpca_desc) == 8, "mpca_desc layout");
 STATIC_ASSERT(sizeof(mpca_stats) == 144 && ALIGNOF(mpca_stats) == 8, "mpca_stats layout");
 STATIC_ASSERT(sizeof(mpca_particle) == 32 && ALIGNOF(mpca_particle) == 4, "mpca_particle layout");
 STATIC_ASSERT(sizeof(mpca_cell) == 36 && ALIGNOF(mpca_cell) == 4, "mpca_cell layout");
@@ -171,6 +171,8 @@ static mpca_desc full_desc(uint32_t dim, uint32_t n) {
     d.mass_classes = 2;
     d.lifetimes = 1;
     d.emitter_capacity = 2;
+    d.drag_rate = 0.1f;
+    d.drag_wind_field = 1;
     return d;
 }
 
@@ -248,6 +250,7 @@ static void build_worlds(void) {
     }
     CHECK_OK(mpca_world_set_force_field(full2, field2, CELLS2 * 2));
     CHECK_OK(mpca_world_set_potential(full2, potential2, CELLS2));
+    CHECK_OK(mpca_world_set_wind_field(full2, field2, CELLS2 * 2)); /* small: a wind too */
     float g[3] = {0, -0.02f, 0}, f[3] = {0.01f, 0, 0};
     CHECK_OK(mpca_world_set_gravity(full2, g));
     CHECK_OK(mpca_world_set_cell_force(full2, p0, f));
@@ -273,6 +276,7 @@ static void build_worlds(void) {
     }
     CHECK_OK(mpca_world_set_force_field(full3, field3, CELLS3 * 3));
     CHECK_OK(mpca_world_set_potential(full3, potential3, CELLS3));
+    CHECK_OK(mpca_world_set_wind_field(full3, field3, CELLS3 * 3));
 
     CHECK_OK(mpca_desc_defaults(&d, 2, 8, 8, 0));
     CHECK_OK(mpca_world_create(&d, &bare2));
@@ -385,6 +389,8 @@ static void description_cases(void) {
         DESC_VALUES(base, contacts, MPCA_STATUS_BAD_ENUM, 2, UINT32_MAX);
         DESC_VALUES(base, energy_neutral, MPCA_STATUS_BAD_ENUM, 2, UINT32_MAX);
         DESC_VALUES(base, drag_vortex, MPCA_STATUS_BAD_ENUM, 2, UINT32_MAX);
+        DESC_VALUES(base, drag_wind_field, MPCA_STATUS_BAD_ENUM, 2, UINT32_MAX);
+        DESC_VALUES(base, reserved, MPCA_STATUS_BAD_ENUM, 1, UINT32_MAX);
         DESC_VALUES(base, mass_classes, MPCA_STATUS_CAPACITY_RANGE, 0, 257, UINT32_MAX);
 
         /* Every float field, the third gravity component in 2D included. */
@@ -537,6 +543,8 @@ static void handle_sweep(mpca_world *h, mpca_status want, const char *kind) {
     REFUSED(want, mpca_world_set_potential(h, potential2, CELLS2));
     REFUSED(want, mpca_world_set_cell_potential(h, pos, 1.0f));
     REFUSED(want, mpca_world_set_vortex(h, 1.0f, 1.0f, 1.0f, 1.0f));
+    REFUSED(want, mpca_world_set_wind_field(h, field2, CELLS2 * 2));
+    REFUSED(want, mpca_world_set_cell_wind(h, pos, v));
     REFUSED(want, mpca_world_add_obstacle(h, pos, n, 1.0f));
     REFUSED(want, mpca_world_add_half_space(h, point, n, 1.0f));
     REFUSED(want, mpca_world_add_box(h, lo, hi, 1.0f));
@@ -676,6 +684,10 @@ static void null_cases(void) {
     REFUSED(MPCA_STATUS_NULL_POINTER, mpca_world_set_cell_force(w, free_cell, NULL));
     REFUSED(MPCA_STATUS_NULL_POINTER, mpca_world_set_potential(w, NULL, CELLS2));
     REFUSED(MPCA_STATUS_NULL_POINTER, mpca_world_set_cell_potential(w, NULL, 1.0f));
+    REFUSED(MPCA_STATUS_NULL_POINTER, mpca_world_set_wind_field(w, NULL, CELLS2 * 2));
+    REFUSED(MPCA_STATUS_NULL_POINTER, mpca_world_set_wind_field(w, NULL, 0));
+    REFUSED(MPCA_STATUS_NULL_POINTER, mpca_world_set_cell_wind(w, NULL, v));
+    REFUSED(MPCA_STATUS_NULL_POINTER, mpca_world_set_cell_wind(w, free_cell, NULL));
     REFUSED(MPCA_STATUS_NULL_POINTER, mpca_world_add_obstacle(w, NULL, up, 1.0f));
     REFUSED(MPCA_STATUS_NULL_POINTER, mpca_world_add_obstacle(w, free_cell, NULL, 1.0f));
     REFUSED(MPCA_STATUS_NULL_POINTER, mpca_world_add_half_space(w, NULL, up, 1.0f));
@@ -882,6 +894,32 @@ static void force_cases(void) {
         REFUSED(MPCA_STATUS_BAD_LENGTH, mpca_world_set_potential(w, potential, (size_t)PTRDIFF_MAX / sizeof(float) + 1));
         EACH_OUTSIDE(pos, dim, n, mpca_world_set_cell_force(w, pos, f));
         EACH_OUTSIDE(pos, dim, n, mpca_world_set_cell_potential(w, pos, u));
+
+        /* M5.1b's wind plane: finite, no cell faster than 1, whole. The
+         * world's plane holds `field` (every speed far below 1). */
+        set_context("%uD wind plane", dim);
+        float wind[3] = {0.1f, -0.2f, 0.05f};
+        for (at = 0; at < 3; at++) {
+            EACH_BAD(wind[at], MPCA_STATUS_NOT_FINITE, mpca_world_set_cell_wind(w, pos, wind));
+        }
+        for (unsigned j = 0; j < 3; j++) {
+            at = elements[j];
+            EACH_BAD(field[at], MPCA_STATUS_NOT_FINITE, mpca_world_set_wind_field(w, field, cells * dim));
+        }
+        float fast[3] = {0.8f, 0.7f, 0.0f}, faster[3] = {1.0001f, 0.0f, 0.0f};
+        REFUSED(MPCA_STATUS_SPEED_RANGE, mpca_world_set_cell_wind(w, pos, fast));
+        REFUSED(MPCA_STATUS_SPEED_RANGE, mpca_world_set_cell_wind(w, pos, faster));
+        for (unsigned j = 0; j < 3; j++) {
+            at = elements[j];
+            float saved = field[at];
+            field[at] = -1.5f;
+            REFUSED(MPCA_STATUS_SPEED_RANGE, mpca_world_set_wind_field(w, field, cells * dim));
+            field[at] = saved;
+        }
+        REFUSED(MPCA_STATUS_BAD_LENGTH, mpca_world_set_wind_field(w, field, cells * dim - 1));
+        REFUSED(MPCA_STATUS_BAD_LENGTH, mpca_world_set_wind_field(w, field, cells));
+        REFUSED(MPCA_STATUS_BAD_LENGTH, mpca_world_set_wind_field(w, field, SIZE_MAX));
+        EACH_OUTSIDE(pos, dim, n, mpca_world_set_cell_wind(w, pos, wind));
     }
 
     set_context("forces in a world without them");
@@ -894,6 +932,8 @@ static void force_cases(void) {
     REFUSED(MPCA_STATUS_NOT_ENABLED, mpca_world_set_potential(bare2, small_potential, 64));
     REFUSED(MPCA_STATUS_NOT_ENABLED, mpca_world_set_cell_potential(bare2, pos, 1.0f));
     REFUSED(MPCA_STATUS_NOT_ENABLED, mpca_world_set_vortex(bare2, 1.0f, 1.0f, 1.0f, 1.0f));
+    REFUSED(MPCA_STATUS_NOT_ENABLED, mpca_world_set_wind_field(bare2, small_field, 64 * 2));
+    REFUSED(MPCA_STATUS_NOT_ENABLED, mpca_world_set_cell_wind(bare2, pos, g));
 }
 
 static void obstacle_cases(void) {

@@ -104,11 +104,21 @@ pub fn smoke() -> Scene {
 
 /// 4.3 with flow drag (M5.1b) in place of the paper's vortex force: smoke
 /// is buoyancy (a uniform upward acceleration of 0.004) plus drag at rate
-/// 0.05 towards the Rankine vortex read as a velocity field (centre
-/// (64, 72), core 10, circulation 9: 0.14 cells per step at the core's
-/// edge), so a plume rises at the terminal speed 0.004 / 0.05 = 0.08 and
-/// is carried round the vortex instead of being flung out at the speed
-/// cap. Calibrated drift, speed-limited collisions; the same emitter.
+/// 0.05 towards the air's flow, so it rises at the terminal speed
+/// 0.004 / 0.05 = 0.08 relative to the air instead of being flung out at
+/// the speed cap. The air's flow is a columnar vortex fed through its core
+/// (the Rankine vortex-sink of a bathtub vortex or a fire whirl, seen in a
+/// section across its axis): the Rankine vortex read as a velocity
+/// (centre (64, 72), core 10, circulation 12: 0.19 cells a step at the
+/// core's edge) plus, in the wind plane, an inflow of the same profile
+/// ([`smoke_flow_wind`]), `Q / (2 pi r)` outside the core, so the
+/// streamlines are spirals that wind in at atan(Q / G) = 34 degrees to the
+/// circles. The air converging on the axis leaves along it, out of the
+/// plane; the smoke cannot, so the plume is wound into the vortex and
+/// gathers in its core, where the inflow balances the buoyant drift. A
+/// purely tangential flow only carries a plume round the vortex's side
+/// (the streamlines of a steady flow without a sink are closed or pass
+/// by). Calibrated drift, speed-limited collisions; the same emitter.
 pub fn smoke_flow() -> Scene {
     let mut desc = Description::new_2d(128, 128).with_boundary(Boundary::Open);
     desc.boundary[1][0] = Boundary::Wall;
@@ -116,11 +126,47 @@ pub fn smoke_flow() -> Scene {
     desc.collisions = mpca::Collisions::SpeedLimited;
     desc.forces.uniform = true;
     desc.gravity = [0.0, 0.004, 0.0];
-    desc.vortex = Vortex { centre: [64.0, 72.0], core_radius: 10.0, circulation: 9.0 };
-    desc.drag = mpca::Drag { rate: 0.05, wind: [0.0; 3], vortex: true };
+    desc.vortex = Vortex { centre: [64.0, 72.0], core_radius: 10.0, circulation: 12.0 };
+    desc.drag = mpca::Drag { rate: 0.05, wind: [0.0; 3], field: true, vortex: true };
     desc.emitter_capacity = 1;
     desc.seed = 43;
-    Scene { name: "smoke-flow", section: "4.3b", desc, steps: 1200, paper_seconds: f64::NAN, setup: fill_smoke }
+    Scene { name: "smoke-flow", section: "4.3b", desc, steps: 1200, paper_seconds: f64::NAN, setup: fill_smoke_flow }
+}
+
+/// The sink strength `Q` of [`smoke_flow`]'s inflow, cells^2 a step: the
+/// air the core takes in a step.
+pub const SMOKE_FLOW_INFLOW: f32 = 8.0;
+
+/// The inflow of [`smoke_flow`] at point `p` towards `centre`: radial, of
+/// magnitude `Q r / (2 pi R^2)` inside the core `R` (a sink spread evenly
+/// over it) and `Q / (2 pi r)` outside: the vortex's own profile, turned
+/// by a right angle, so `-Q (dx, dy) / (2 pi max(r^2, R^2))`. Computed
+/// with `+ - * /` only, as `c_examples/smoke.c` computes it, so the C and
+/// the Rust scene hold the same bits.
+pub fn smoke_flow_wind(centre: [f32; 2], core_radius: f32, inflow: f32, p: [f32; 2]) -> [f32; 2] {
+    let (dx, dy) = (p[0] - centre[0], p[1] - centre[1]);
+    let r2 = (dx * dx + dy * dy).max(core_radius * core_radius);
+    let s = -inflow / (core::f32::consts::TAU * r2);
+    [dx * s, dy * s]
+}
+
+/// The smoke's emitter and, where the world has the plane, the inflow of
+/// [`smoke_flow`] in the wind plane.
+fn fill_smoke_flow(w: &mut World) -> Result<(), Error> {
+    fill_smoke(w)?;
+    let d = *w.description();
+    if d.drag.field {
+        let [nx, ny, _] = d.size;
+        let mut plane = Vec::with_capacity(2 * nx as usize * ny as usize);
+        for y in 0..ny {
+            for x in 0..nx {
+                let p = [x as f32 + 0.5, y as f32 + 0.5];
+                plane.extend(smoke_flow_wind(d.vortex.centre, d.vortex.core_radius, SMOKE_FLOW_INFLOW, p));
+            }
+        }
+        w.set_wind_field(&plane)?;
+    }
+    Ok(())
 }
 
 fn fill_smoke(w: &mut World) -> Result<(), Error> {

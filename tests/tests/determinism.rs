@@ -53,7 +53,7 @@ fn description(dim: u32, faces: Faces, variant: usize) -> Description {
     desc.contacts = variant % 4 < 2;
     desc.energy_neutral = variant % 3 == 1;
     if variant % 2 == 0 {
-        desc.drag = Drag { rate: 0.2, wind: [0.05, 0.1, -0.05], vortex: dim == 2 };
+        desc.drag = Drag { rate: 0.2, wind: [0.05, 0.1, -0.05], field: variant % 4 == 0, vortex: dim == 2 };
     }
     desc.seed = 0x5eed_0000 + variant as u64;
     desc
@@ -65,6 +65,7 @@ struct Inputs {
     particles: Vec<([u32; 3], [f32; 3], f32)>,
     field: Vec<f32>,
     potential: Vec<f32>,
+    wind: Vec<f32>,
 }
 
 fn inputs(desc: &Description, seed: u64) -> Inputs {
@@ -80,7 +81,8 @@ fn inputs(desc: &Description, seed: u64) -> Inputs {
     let d = desc.dim as usize;
     let field = (0..cells.len() * d).map(|_| 0.02 * (rng.unit() - 0.5)).collect();
     let potential = cells.iter().map(|c| 0.05 * ((c[0] as f32 * 0.4).sin() + (c[1] as f32 * 0.3).cos())).collect();
-    Inputs { particles, field, potential }
+    let wind = (0..cells.len() * d).map(|_| 0.4 * (rng.unit() - 0.5)).collect();
+    Inputs { particles, field, potential, wind }
 }
 
 /// Builds and fills a world in `memory`; `reverse` adds the particles in the
@@ -102,6 +104,9 @@ fn build<'a>(desc: &Description, inputs: &Inputs, memory: &'a mut [u8], reverse:
     world.add_shape(box_, 0.6).unwrap();
     world.set_force_field(&inputs.field).unwrap();
     world.set_potential(&inputs.potential).unwrap();
+    if desc.drag.field {
+        world.set_wind_field(&inputs.wind).unwrap();
+    }
     let add = |world: &mut World, &(pos, v, m): &([u32; 3], [f32; 3], f32)| {
         if !world.obstacle_at(pos) {
             world.add_particle_with_mass(pos, v, m).unwrap();
@@ -234,7 +239,8 @@ fn queries_and_step_batching_change_nothing() {
 /// paper's scenes run in a world that also enables per-particle masses,
 /// obstacles (none placed), lifetimes (none given), emitter room, and every
 /// force term at zero strength (zero gravity, an all-zero field and
-/// potential, a vortex of zero circulation). Expected: the same hash after
+/// potential, a vortex of zero circulation) and an all-zero wind plane
+/// (M5.1b, drag off). Expected: the same hash after
 /// every step as the same scene in its own lean world, and more bytes per
 /// cell.
 #[test]
@@ -257,6 +263,7 @@ fn unused_parts_change_nothing_but_memory() {
         }
         d.forces.field = true;
         d.forces.potential = true;
+        d.drag.field = true;
         if !d.forces.vortex {
             d.forces.vortex = true;
             d.vortex = Vortex { centre: [3.0, 5.0], core_radius: 2.0, circulation: 0.0 };
@@ -267,6 +274,7 @@ fn unused_parts_change_nothing_but_memory() {
         let cells: usize = d.size[..d.dim as usize].iter().map(|&s| s as usize).product();
         full.set_force_field(&vec![0.0; cells * d.dim as usize]).unwrap();
         full.set_potential(&vec![0.0; cells]).unwrap();
+        full.set_wind_field(&vec![0.0; cells * d.dim as usize]).unwrap();
         assert!(full.bytes_per_cell() > lean.bytes_per_cell());
         for step in 0..scene.steps.min(200) {
             assert_eq!(full.state_hash(), lean.state_hash(), "{}: worlds differ after {step} steps", scene.name);

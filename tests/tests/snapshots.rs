@@ -12,7 +12,7 @@
 //! - Region counters against a count of the particles by hand.
 
 use mpca::{
-    image_description, world_bytes, Boundary, Collisions, Description, Emitter, Error, Forces, Method, Quantization,
+    image_description, world_bytes, Boundary, Collisions, Description, Drag, Emitter, Error, Forces, Method, Quantization,
     RegionStats, Shape, Stats, Vortex, World, IMAGE_VERSION,
 };
 use mpca_tests::scenes::{self, paper_scenes};
@@ -98,14 +98,28 @@ fn small_desc() -> Description {
     d
 }
 
+/// The small world with drag towards a wind plane too (M5.1b).
+fn windy_desc() -> Description {
+    let mut d = small_desc();
+    d.drag = Drag { rate: 0.05, wind: [0.0, 0.01, 0.0], field: true, vortex: false };
+    d
+}
+
 fn small_world(memory: &mut Vec<u8>, steps: u64) -> &mut World {
-    let d = small_desc();
+    small_world_of(small_desc(), memory, steps)
+}
+
+fn small_world_of(d: Description, memory: &mut Vec<u8>, steps: u64) -> &mut World {
     *memory = vec![0u8; world_bytes(&d).unwrap()];
     let w = World::init(&d, memory).unwrap();
     let field: Vec<f32> = (0..256 * 2).map(|i| ((i % 5) as f32 - 2.0) * 0.002).collect();
     w.set_force_field(&field).unwrap();
     let potential: Vec<f32> = (0..256).map(|i| ((i % 16) as f32 - 8.0).abs() * 0.001).collect();
     w.set_potential(&potential).unwrap();
+    if d.drag.field {
+        let wind: Vec<f32> = (0..256 * 2).map(|i| ((i % 7) as f32 - 3.0) * 0.05).collect();
+        w.set_wind_field(&wind).unwrap();
+    }
     w.add_shape(Shape::Disc { centre: [5.0, 5.0], radius: 2.0 }, 0.8).unwrap();
     let mut mask = vec![0u8; 256];
     for (x, y) in [(12, 4), (13, 4), (12, 5), (13, 5)] {
@@ -195,6 +209,8 @@ fn every_part_worlds_load_bit_identical_and_step_on_alike() {
     let w = small_world(&mut memory, 25);
     assert!(w.stats().emitted > 0 && w.stats().collisions > 0, "{:?}", w.stats());
     round_trip("small", w, 40);
+    let w = small_world_of(windy_desc(), &mut memory, 25);
+    round_trip("small, wind plane", w, 40);
 }
 
 /// An image saved from the small world at step 25, and a different world of
@@ -398,7 +414,9 @@ fn images_resealed_around_content_no_world_holds_are_refused() {
         ("boundary 3", Error::ImageInvalid, Box::new(move |i| i[DESC_AT + 24] = 3)),
         ("quantization 12", Error::ImageInvalid, Box::new(move |i| i[DESC_AT + 30] = 12)),
         ("flag 2", Error::ImageInvalid, Box::new(move |i| i[DESC_AT + 34] = 2)),
-        ("reserved description byte", Error::ImageInvalid, Box::new(move |i| i[DESC_AT + 116] = 1)),
+        ("reserved description byte", Error::ImageInvalid, Box::new(move |i| i[DESC_AT + 117] = 1)),
+        ("wind-plane flag 2", Error::ImageInvalid, Box::new(move |i| i[DESC_AT + 116] = 2)),
+        ("wind-plane flag without the plane", Error::ImageInvalid, Box::new(move |i| i[DESC_AT + 116] = 1)),
         ("drag-vortex flag 2", Error::ImageInvalid, Box::new(move |i| i[DESC_AT + 43] = 2)),
         ("NaN restitution", Error::ImageInvalid, Box::new(move |i| set_u32(i, DESC_AT + 88, f32::NAN.to_bits()))),
         ("particle count + 1", Error::ImageInvalid, Box::new(move |i| set_u64(i, PARTICLES_AT, p.particles as u64 + 1))),
@@ -472,6 +490,53 @@ fn images_resealed_around_content_no_world_holds_are_refused() {
     reseal(&mut same);
     target.load(&same).unwrap();
     println!("{n} re-sealed images refused");
+}
+
+/// M5.1b's wind plane in an image (M12): after the force planes, `dim`
+/// floats a cell, flagged in the description's byte 116. A world without
+/// the plane writes the image it wrote before the plane existed (the
+/// pinned format test), so the flag set there, a flag of 2, a NaN wind
+/// and a cell faster than 1 are refused, and change nothing.
+#[test]
+fn images_with_a_wind_plane_no_world_could_hold_are_refused() {
+    let mut memory = Vec::new();
+    let img = image(small_world_of(windy_desc(), &mut memory, 7));
+    let mut other = Vec::new();
+    let target = small_world_of(windy_desc(), &mut other, 0);
+    let before = fingerprint(target);
+    let dry = image(small_world_of(small_desc(), &mut Vec::new(), 0));
+    let wet = image(small_world_of(windy_desc(), &mut Vec::new(), 0));
+    assert_eq!((img[DESC_AT + 116], dry[DESC_AT + 116]), (1, 0));
+    // The wind plane lies after the potential, 256 cells of 2 floats,
+    // before the mass table and the other tables.
+    let tables = 4 * u32_at(&img, TABLES_AT) as usize + 24 * u32_at(&img, TABLES_AT + 4) as usize + 56 * u32_at(&img, TABLES_AT + 8) as usize;
+    let wind = img.len() - 4 - tables - 256 * 2 * 4;
+    assert_eq!(wet.len() - dry.len(), 256 * 2 * 4, "the plane is what the image gains");
+    let set_u32 = |img: &mut Vec<u8>, at: usize, v: u32| img[at..at + 4].copy_from_slice(&v.to_le_bytes());
+    type Edit = Box<dyn Fn(&mut Vec<u8>)>;
+    let cases: Vec<(&str, Edit)> = vec![
+        ("wind-plane flag 2", Box::new(|i| i[DESC_AT + 116] = 2)),
+        ("NaN wind", Box::new(move |i| set_u32(i, wind + 12, f32::NAN.to_bits()))),
+        ("infinite wind", Box::new(move |i| set_u32(i, wind, f32::NEG_INFINITY.to_bits()))),
+        ("a cell of speed 1.2", Box::new(move |i| {
+            set_u32(i, wind + 8, 0.6f32.to_bits());
+            set_u32(i, wind + 12, (-1.04f32).to_bits());
+        })),
+    ];
+    for (what, edit) in cases {
+        let mut bad = img.clone();
+        edit(&mut bad);
+        reseal(&mut bad);
+        assert_eq!(target.load(&bad), Err(Error::ImageInvalid), "{what}");
+        assert_eq!(fingerprint(target), before, "{what}");
+    }
+    // Read back as written: a wind of speed exactly within 1 is taken.
+    let mut fine = img.clone();
+    set_u32(&mut fine, wind + 8, 0.6f32.to_bits());
+    set_u32(&mut fine, wind + 12, (-0.79f32).to_bits());
+    reseal(&mut fine);
+    target.load(&fine).unwrap();
+    assert_eq!(image(target), fine);
 }
 
 #[test]
