@@ -652,7 +652,8 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
     /// lifetimes, no force but a uniform one) away from the faces and
     /// without an obstacle: [`Kernel::general`] without what such a block
     /// cannot have. Cell `c`
-    /// has x `xs[c & 1]` in block row `c >> 1`.
+    /// has x `xs[c & 1]` in block row `c >> 1`; the two are neighbours (the
+    /// block that wraps round a periodic axis goes to the general routine).
     #[inline(always)]
     fn lean(&mut self, row: &BlockRow, xs: [usize; 2], index: u64, occ: u8) {
         let sh = self.shared;
@@ -1012,11 +1013,13 @@ impl<'a, Q: Quant, const D: usize, const CELLS: usize> BlockSink<'a> for Kernel<
                 }
                 return self.general(row, x0 as isize, bx, occ);
             }
-            let x1 = if x0 + 1 < sh.n[0] { Some(x0 + 1) } else { sh.part.axes[0].periodic.then_some(0) };
-            if let Some(x1) = x1 {
+            // The block that wraps round a periodic x axis goes through
+            // the general routine: the lean one reads each block row's two
+            // cells as neighbours.
+            if x0 + 1 < sh.n[0] {
                 // A world with obstacles: only blocks without one are lean.
-                if !sh.desc.obstacles || read_block::<CELLS>(sh.obstacle, row, [x0, x1]) == 0 {
-                    return self.lean(row, [x0, x1], row.index + bx as u64, occ);
+                if !sh.desc.obstacles || read_block::<CELLS>(sh.obstacle, row, [x0, x0 + 1]) == 0 {
+                    return self.lean(row, [x0, x0 + 1], row.index + bx as u64, occ);
                 }
             }
         }
