@@ -48,7 +48,7 @@ use crate::obstacle::{reflect, surface_at, Surface};
 use crate::partition::{cells_at, resolve, BlockRow, BlockSink, Beyond, Index, Partition};
 use crate::quant::Quant;
 use crate::rng::{StepKey, Stream};
-use crate::vector::{clamp, dot, normalise};
+use crate::vector::{clamp_long, dot, normalise};
 use crate::layout::{mark, put_bit};
 use crate::world::{Counters, ENERGY_SCALE};
 
@@ -299,18 +299,25 @@ pub(crate) fn back_normal<const D: usize>(from: usize, to: usize) -> [f32; 3] {
 }
 
 /// M5.5: clamps `x` (in quanta) to the speed limit `scale`, counting the
-/// clamp and the kinetic energy it removed for mass `m`.
+/// clamp and the kinetic energy it removed for mass `m`. Only the test is
+/// inlined: a clamp is rare, and its code would otherwise be copied into
+/// every stage of every block routine.
 #[inline(always)]
 fn clamp_counted(x: &mut [f32; 3], scale: f32, m: f32, counters: &mut Counters) {
-    if let Some(s2) = clamp(x, scale) {
-        count_clamp(s2 / (scale * scale), m, counters);
+    let s2 = dot(*x, *x);
+    if s2 <= scale * scale {
+        return;
     }
+    clamp_and_count(x, s2, scale, m, counters);
 }
 
-/// Counts a clamp of a particle of mass `m` whose squared speed was `s2`
-/// (cells per step), and the kinetic energy it removed.
+/// The rest of [`clamp_counted`]: the clamp, and the count of the clamp
+/// and of the kinetic energy it removed, from the squared speed `s2` it
+/// had (in cells per step).
 #[cold]
-fn count_clamp(s2: f32, m: f32, counters: &mut Counters) {
+#[inline(never)]
+fn clamp_and_count(x: &mut [f32; 3], s2: f32, scale: f32, m: f32, counters: &mut Counters) {
+    let s2 = clamp_long(x, s2, scale) / (scale * scale);
     counters.clamps += 1;
     // f32 and a saturating cast: no f64 or 128-bit arithmetic, which small
     // cores emulate; f32's 24 bits are far finer than the statistic needs.

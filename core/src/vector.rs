@@ -27,12 +27,14 @@ pub(crate) fn clamp(v: &mut [f32; 3], limit: f32) -> Option<f32> {
     if s2 <= limit * limit {
         return None;
     }
-    clamp_long(v, s2, limit)
+    Some(clamp_long(v, s2, limit))
 }
 
-/// The part of [`clamp`] that runs only when it clamps.
+/// The part of [`clamp`] that runs only when it clamps: `s2` is the squared
+/// length of `v`, more than `limit` squared (or NaN), and comes back (as
+/// infinity where `v` overflowed).
 #[cold]
-fn clamp_long(v: &mut [f32; 3], s2: f32, limit: f32) -> Option<f32> {
+pub(crate) fn clamp_long(v: &mut [f32; 3], s2: f32, limit: f32) -> f32 {
     if !s2.is_finite() {
         // In units of the limit, so that "short enough" means length <= 1.
         for c in v.iter_mut() {
@@ -56,13 +58,13 @@ fn clamp_long(v: &mut [f32; 3], s2: f32, limit: f32) -> Option<f32> {
         for c in v.iter_mut() {
             *c *= limit;
         }
-        return Some(f32::INFINITY);
+        return f32::INFINITY;
     }
     let scale = limit / libm::sqrtf(s2);
     for c in v.iter_mut() {
         *c *= scale;
     }
-    Some(s2)
+    s2
 }
 
 #[cfg(test)]
