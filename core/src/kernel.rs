@@ -336,6 +336,58 @@ struct Wanted {
     wall: bool,
 }
 
+/// M5.4: the particle in cell `c` of mass `m`, with velocity `x` (in
+/// quanta, `scale` to a unit speed), wants the blocked cell `to`: its
+/// velocity reflected off that cell's surface (eq. 9) and clamped, or `None`
+/// where the surface says the particle is already leaving and it keeps its
+/// velocity. Either way the caller keeps the particle in its cell this step.
+/// Rare, so kept out of the block routine's straight line, and the same
+/// code for both velocity widths.
+#[cold]
+#[inline(never)]
+fn reflect_off<const D: usize>(sh: &Shared<'_>, x: [f32; 3], c: usize, to: Wanted, m: f32, scale: f32, counters: &mut Counters) -> Option<[f32; 3]> {
+    let t = to.cell;
+    let mut surface = None;
+    if to.wall {
+        if let Beyond::Wall(n) = resolve(sh.n, &sh.desc.boundary, to.at) {
+            surface = Some((n, sh.desc.wall_restitution));
+        }
+    }
+    let (n, e) = surface.unwrap_or_else(|| match surface_at(sh.surface, to.site as u32) {
+        Some(s) => (s.normal, s.restitution),
+        // Unreachable for obstacles added through the API (every cell
+        // next to a free one has an entry): the direction back to the
+        // particle.
+        None => (back_normal::<D>(c, t), sh.desc.wall_restitution),
+    });
+    let back = back_normal::<D>(c, t);
+    let n = if dot(x, n) < 0.0 {
+        n
+    } else {
+        // The particle already leaves the surface (N.v >= 0), yet asks
+        // for one of its cells: a stair of a surface tilted against the
+        // grid. Where N faces the particle's cell, the particle is on
+        // the free side of that surface: it keeps its velocity and only
+        // this move is refused, unless no cell along one axis of its
+        // velocity is free, which would leave it stuck (a concave
+        // corner where shapes overlap). Otherwise, or where N does not
+        // face the particle (a half-space seen across a periodic seam, a
+        // mask corner), it would press on the obstacle for ever: reflect
+        // off the face it came through. M5.4.
+        let mut at = to.at;
+        for (k, a) in at.iter_mut().enumerate().take(D) {
+            *a += ((c >> k) & 1) as i64 - ((t >> k) & 1) as i64;
+        }
+        if dot(n, back) > 0.0 && crate::obstacle::axis_move_free(sh.obstacle, sh.n, &sh.desc.boundary, at, x, D) {
+            return None;
+        }
+        back
+    };
+    let mut x = reflect(x, n, e); // eq. 9
+    clamp_counted(&mut x, scale, m, counters);
+    Some(x)
+}
+
 /// A block's particles as the stages of M5 see them.
 struct Block<const D: usize, const CELLS: usize> {
     /// Cells holding a particle.
@@ -380,6 +432,13 @@ impl<const D: usize, const CELLS: usize> Block<D, CELLS> {
         }
         self.dirty |= self.pending;
         self.pending = 0;
+    }
+
+    /// [`Block::round`] out of line, after a stage that seldom changes a
+    /// velocity: a reflection (M5.4).
+    #[inline(never)]
+    fn round_apart<Q: Quant>(&mut self, rng: &mut Stream) {
+        self.round::<Q>(rng);
     }
 }
 
@@ -506,59 +565,6 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
             m |= u8::from((r >> (16 * k)) as u32 & 0xffff <= Q::move_limit(table, drift, q[k])) << k;
         }
         m & inward
-    }
-
-    /// M5.4: the particle in cell `c` of mass `m` wants the blocked cell
-    /// `to`: reflect its velocity off that cell's surface (eq. 9) and clamp
-    /// it, or keep it where the surface says the particle is already leaving.
-    /// Either way the caller keeps the particle in its cell this step. Rare,
-    /// so kept out of the block routine's straight line.
-    #[cold]
-    #[inline(never)]
-    fn reflect_off(&mut self, b: &mut Block<D, CELLS>, c: usize, to: Wanted, m: f32, rng: &mut Stream) {
-        let sh = self.shared;
-        let t = to.cell;
-        let mut surface = None;
-        if to.wall {
-            if let Beyond::Wall(n) = resolve(sh.n, &sh.desc.boundary, to.at) {
-                surface = Some((n, sh.desc.wall_restitution));
-            }
-        }
-        let (n, e) = surface.unwrap_or_else(|| match surface_at(sh.surface, to.site as u32) {
-            Some(s) => (s.normal, s.restitution),
-            // Unreachable for obstacles added through the API (every cell
-            // next to a free one has an entry): the direction back to the
-            // particle.
-            None => (back_normal::<D>(c, t), sh.desc.wall_restitution),
-        });
-        let x = b.velocity(c);
-        let back = back_normal::<D>(c, t);
-        let n = if dot(x, n) < 0.0 {
-            n
-        } else {
-            // The particle already leaves the surface (N.v >= 0), yet asks
-            // for one of its cells: a stair of a surface tilted against the
-            // grid. Where N faces the particle's cell, the particle is on
-            // the free side of that surface: it keeps its velocity and only
-            // this move is refused, unless no cell along one axis of its
-            // velocity is free, which would leave it stuck (a concave
-            // corner where shapes overlap). Otherwise, or where N does not
-            // face the particle (a half-space seen across a periodic seam, a
-            // mask corner), it would press on the obstacle for ever: reflect
-            // off the face it came through. M5.4.
-            let mut at = to.at;
-            for (k, a) in at.iter_mut().enumerate().take(D) {
-                *a += ((c >> k) & 1) as i64 - ((t >> k) & 1) as i64;
-            }
-            if dot(n, back) > 0.0 && crate::obstacle::axis_move_free(sh.obstacle, sh.n, &sh.desc.boundary, at, x, D) {
-                return;
-            }
-            back
-        };
-        let mut x = reflect(x, n, e); // eq. 9
-        clamp_counted(&mut x, Q::SCALE, m, &mut self.counters);
-        b.set(c, x);
-        b.round::<Q>(rng);
     }
 
     /// M5.6: where each particle goes, `targets >> 4c & 7` for the particle
@@ -948,7 +954,11 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
             let t = c ^ usize::from(m);
             if m != 0 && blocked >> t & 1 != 0 {
                 let to = Wanted { cell: t, site: cell(t), at: at(t), wall: wall >> t & 1 != 0 };
-                self.reflect_off(&mut b, c, to, mass[c], &mut rng);
+                // M5.4, its new velocity rounded at once (M1).
+                if let Some(x) = reflect_off::<D>(sh, b.velocity(c), c, to, mass[c], Q::SCALE, &mut self.counters) {
+                    b.set(c, x);
+                    b.round_apart::<Q>(&mut rng);
+                }
                 m = 0;
             }
             want[c] = m;
