@@ -388,6 +388,49 @@ fn reflect_off<const D: usize>(sh: &Shared<'_>, x: [f32; 3], c: usize, to: Wante
     Some(x)
 }
 
+/// M5.7: every particle refused the cell it wanted (`want`, by the
+/// assignment's `targets`) meets the particle that holds that cell, in the
+/// order of the refused particles' cells: eqs. 7-8 with `R` from the wanted
+/// cell back towards the refused particle's, if it was closing in, then the
+/// clamp to `scale` quanta. `mass` holds each cell's mass, by the cell the
+/// particle started in. Out of line, one copy for both velocity widths:
+/// only worlds with contacts come here, and they pay one call a block.
+#[inline(never)]
+fn contacts<const D: usize, const CELLS: usize>(
+    sh: &Shared<'_>,
+    b: &mut Block<D, CELLS>,
+    want: &[u8; CELLS],
+    targets: u32,
+    mass: &[f32; CELLS],
+    scale: f32,
+    counters: &mut Counters,
+) {
+    let equal = !sh.desc.per_particle_mass;
+    for a in cells_of(b.occ) {
+        let wanted = a ^ usize::from(want[a]);
+        if want[a] == 0 || (targets >> (4 * a) & 7) as usize == wanted {
+            continue;
+        }
+        // The particle placed in the wanted cell, if any.
+        let Some(h) = cells_of(b.occ).find(|&h| (targets >> (4 * h) & 7) as usize == wanted) else { continue };
+        let r = back_normal::<D>(a, wanted);
+        let (xa, xh) = (b.velocity(a), b.velocity(h));
+        if dot([xa[0] - xh[0], xa[1] - xh[1], xa[2] - xh[2]], r) >= 0.0 {
+            continue;
+        }
+        let (ma, mh) = (mass[a], mass[h]);
+        let s = if equal { (0.5, 0.5) } else { shares(ma, mh) };
+        let (mut ya, mut yh) = collide_pair(xa, xh, s, sh.desc.restitution, r);
+        if sh.desc.energy_neutral {
+            (ya, yh) = energy_neutral(ya, yh, s);
+        }
+        clamp_counted(&mut ya, scale, ma, counters);
+        clamp_counted(&mut yh, scale, mh, counters);
+        b.set(a, ya);
+        b.set(h, yh);
+    }
+}
+
 /// A block's particles as the stages of M5 see them.
 struct Block<const D: usize, const CELLS: usize> {
     /// Cells holding a particle.
@@ -434,8 +477,8 @@ impl<const D: usize, const CELLS: usize> Block<D, CELLS> {
         self.pending = 0;
     }
 
-    /// [`Block::round`] out of line, after a stage that seldom changes a
-    /// velocity: a reflection (M5.4).
+    /// [`Block::round`] out of line, after the stages that seldom change a
+    /// velocity: a reflection (M5.4) and contacts (M5.7).
     #[inline(never)]
     fn round_apart<Q: Quant>(&mut self, rng: &mut Stream) {
         self.round::<Q>(rng);
@@ -608,39 +651,6 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
         targets
     }
 
-    /// M5.7: every particle refused the cell it wanted (`want`, by the
-    /// assignment's `targets`) meets the particle that holds that cell,
-    /// in the order of the refused particles' cells: eqs. 7-8 with `R` from
-    /// the wanted cell back towards the refused particle's, if it was
-    /// closing in, then the clamp. `mass` gives a cell's mass, by the cell
-    /// the particle started in.
-    #[inline(always)]
-    fn contacts(&mut self, b: &mut Block<D, CELLS>, want: &[u8; CELLS], targets: u32, mass: impl Fn(usize) -> f32, equal: bool) {
-        for a in cells_of(b.occ) {
-            let wanted = a ^ usize::from(want[a]);
-            if want[a] == 0 || (targets >> (4 * a) & 7) as usize == wanted {
-                continue;
-            }
-            // The particle placed in the wanted cell, if any.
-            let Some(h) = cells_of(b.occ).find(|&h| (targets >> (4 * h) & 7) as usize == wanted) else { continue };
-            let r = back_normal::<D>(a, wanted);
-            let (xa, xh) = (b.velocity(a), b.velocity(h));
-            if dot([xa[0] - xh[0], xa[1] - xh[1], xa[2] - xh[2]], r) >= 0.0 {
-                continue;
-            }
-            let (ma, mh) = (mass(a), mass(h));
-            let s = if equal { (0.5, 0.5) } else { shares(ma, mh) };
-            let (mut ya, mut yh) = collide_pair(xa, xh, s, self.shared.desc.restitution, r);
-            if self.shared.desc.energy_neutral {
-                (ya, yh) = energy_neutral(ya, yh, s);
-            }
-            clamp_counted(&mut ya, Q::SCALE, ma, &mut self.counters);
-            clamp_counted(&mut yh, Q::SCALE, mh, &mut self.counters);
-            b.set(a, ya);
-            b.set(h, yh);
-        }
-    }
-
     /// Writes the velocity of the particle of cell `c` to cell `to` of the
     /// planes.
     #[inline(always)]
@@ -694,8 +704,8 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
         });
         let targets = self.assign(occ, |c| { let x = b.velocity(c); dot(x, x) }, 0, &want, key, &mut rng);
         if sh.desc.contacts && wanted != 0 {
-            self.contacts(&mut b, &want, targets, |_| mass, true);
-            b.round::<Q>(&mut rng);
+            contacts(sh, &mut b, &want, targets, &[mass; CELLS], Q::SCALE, &mut self.counters);
+            b.round_apart::<Q>(&mut rng);
         }
         self.counters.processed += 1;
         if (targets ^ IDENTITY) & FIELDS[usize::from(occ)] == 0 && b.dirty == 0 {
@@ -973,8 +983,8 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
 
         // M5.7 contacts, then M1 for what they changed.
         if desc.contacts && wanted != 0 {
-            self.contacts(&mut b, &want, targets, |c| mass[c], !desc.per_particle_mass);
-            b.round::<Q>(&mut rng);
+            contacts(sh, &mut b, &want, targets, &mass, Q::SCALE, &mut self.counters);
+            b.round_apart::<Q>(&mut rng);
         }
 
         // Write back what changed.
