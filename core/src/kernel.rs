@@ -48,7 +48,7 @@ use crate::obstacle::{reflect, surface_at, Surface};
 use crate::partition::{cells_at, resolve, BlockRow, BlockSink, Beyond, Index, Partition};
 use crate::quant::Quant;
 use crate::rng::{StepKey, Stream};
-use crate::vector::{clamp_of, dot, dot_of, normalise};
+use crate::vector::{clamp_long, dot, dot_of, normalise};
 use crate::layout::{mark, put_bit};
 use crate::world::{Counters, ENERGY_SCALE};
 
@@ -307,23 +307,34 @@ pub(crate) fn back_normal<const D: usize>(from: usize, to: usize) -> [f32; 3] {
 }
 
 /// M5.5: clamps `x` (in quanta) to the speed limit `scale`, counting the
-/// clamp and the kinetic energy it removed for mass `m`.
+/// clamp and the kinetic energy it removed for mass `m`. Only the test is
+/// inlined: a clamp is rare, and its code would otherwise be copied into
+/// every stage of every block routine.
 #[inline(always)]
 fn clamp_counted<const D: usize>(x: &mut [f32; 3], scale: f32, m: f32, counters: &mut Counters) {
-    if let Some(s2) = clamp_of::<D>(x, scale) {
-        count_clamp(s2 / (scale * scale), m, counters);
+    let s2 = dot_of::<D>(*x, *x);
+    if s2 <= scale * scale {
+        return;
     }
+    // By value through the call: a velocity whose address never escapes
+    // stays in registers.
+    *x = clamp_and_count(*x, s2, scale, m, counters);
 }
 
-/// Counts a clamp of a particle of mass `m` whose squared speed was `s2`
-/// (cells per step), and the kinetic energy it removed.
+/// The rest of [`clamp_counted`]: the clamp, and the count of the clamp
+/// and of the kinetic energy it removed, from the squared speed `s2` it
+/// had (in cells per step).
 #[cold]
-fn count_clamp(s2: f32, m: f32, counters: &mut Counters) {
+#[inline(never)]
+fn clamp_and_count(x: [f32; 3], s2: f32, scale: f32, m: f32, counters: &mut Counters) -> [f32; 3] {
+    let (x, s2) = clamp_long(x, s2, scale);
+    let s2 = s2 / (scale * scale);
     counters.clamps += 1;
     // f32 and a saturating cast: no f64 or 128-bit arithmetic, which small
     // cores emulate; f32's 24 bits are far finer than the statistic needs.
     let fixed = (0.5 * m * (s2 - 1.0) * ENERGY_SCALE as f32) as u64;
     counters.clamp_energy = counters.clamp_energy.saturating_add(fixed);
+    x
 }
 
 /// A blocked cell a particle wants (M5.4): its number in the block, its
@@ -335,6 +346,142 @@ struct Wanted {
     site: usize,
     at: [i64; 3],
     wall: bool,
+}
+
+/// M5.4: the particle in cell `c` of mass `m`, with velocity `x` (in
+/// quanta, `scale` to a unit speed), wants the blocked cell `to`: its
+/// velocity reflected off that cell's surface (eq. 9) and clamped, or `None`
+/// where the surface says the particle is already leaving and it keeps its
+/// velocity. Either way the caller keeps the particle in its cell this step.
+/// Rare, so kept out of the block routine's straight line, and the same
+/// code for both velocity widths.
+#[cold]
+#[inline(never)]
+fn reflect_off<const D: usize>(sh: &Shared<'_>, x: [f32; 3], c: usize, to: Wanted, m: f32, scale: f32, counters: &mut Counters) -> Option<[f32; 3]> {
+    let t = to.cell;
+    let mut surface = None;
+    if to.wall {
+        if let Beyond::Wall(n) = resolve(sh.n, &sh.desc.boundary, to.at) {
+            surface = Some((n, sh.desc.wall_restitution));
+        }
+    }
+    let (n, e) = surface.unwrap_or_else(|| match surface_at(sh.surface, to.site as u32) {
+        // Component by component: a copy of the array through the
+        // reference is a `memmove` call at opt-level z, the only one in a
+        // firmware build (1.5 KB of flash).
+        Some(s) => ([s.normal[0], s.normal[1], s.normal[2]], s.restitution),
+        // Unreachable for obstacles added through the API (every cell
+        // next to a free one has an entry): the direction back to the
+        // particle.
+        None => (back_normal::<D>(c, t), sh.desc.wall_restitution),
+    });
+    let back = back_normal::<D>(c, t);
+    let n = if dot(x, n) < 0.0 {
+        n
+    } else {
+        // The particle already leaves the surface (N.v >= 0), yet asks
+        // for one of its cells: a stair of a surface tilted against the
+        // grid. Where N faces the particle's cell, the particle is on
+        // the free side of that surface: it keeps its velocity and only
+        // this move is refused, unless no cell along one axis of its
+        // velocity is free, which would leave it stuck (a concave
+        // corner where shapes overlap). Otherwise, or where N does not
+        // face the particle (a half-space seen across a periodic seam, a
+        // mask corner), it would press on the obstacle for ever: reflect
+        // off the face it came through. M5.4.
+        let mut at = to.at;
+        for (k, a) in at.iter_mut().enumerate().take(D) {
+            *a += ((c >> k) & 1) as i64 - ((t >> k) & 1) as i64;
+        }
+        if dot(n, back) > 0.0 && crate::obstacle::axis_move_free(sh.obstacle, sh.n, &sh.desc.boundary, at, x, D) {
+            return None;
+        }
+        back
+    };
+    let mut x = reflect(x, n, e); // eq. 9
+    clamp_counted::<D>(&mut x, scale, m, counters);
+    Some(x)
+}
+
+/// M5.6 by `method` (not 2D exact-fast, which [`Kernel::assign`] takes to
+/// the table) for the particles of the cells of `occ`, which want to cross
+/// the axes `want` of their cell, into the cells `free`; `speed2` gives a
+/// cell's squared speed (for greedy). Where each particle goes, as
+/// [`Kernel::assign`] returns it, adding to `displaced` those not placed in
+/// their desired cell.
+#[inline(always)]
+fn solve_block<const D: usize, const CELLS: usize>(
+    method: Method,
+    (occ, free): (u8, u8),
+    want: &[u8; CELLS],
+    speed2: impl Fn(usize) -> f32,
+    rng: &mut Stream,
+    displaced: &mut u64,
+) -> u32 {
+    let mut problem = MoveProblem { free, count: occ.count_ones() as usize, ..MoveProblem::default() };
+    for (i, c) in cells_of(occ).enumerate() {
+        problem.current[i] = c as u8;
+        problem.desired[i] = c as u8 ^ want[c];
+        if method == Method::Greedy {
+            problem.speed2[i] = speed2(c);
+        }
+    }
+    let moves = assign_moves::<D>(method, &problem, rng);
+    let mut targets = 0u32;
+    for i in 0..problem.count {
+        targets |= u32::from(moves.target[i]) << (4 * problem.current[i]);
+        *displaced += u64::from(moves.target[i] != problem.desired[i]);
+    }
+    targets
+}
+
+/// [`solve_block`] in 2D, out of line, with the squared speeds by cell.
+#[inline(never)]
+fn solve_block_2d(method: Method, cells: (u8, u8), want: &[u8; 4], speeds: &[f32; 4], rng: &mut Stream, displaced: &mut u64) -> u32 {
+    solve_block::<2, 4>(method, cells, want, |c| speeds[c], rng, displaced)
+}
+
+/// M5.7: every particle refused the cell it wanted (`want`, by the
+/// assignment's `targets`) meets the particle that holds that cell, in the
+/// order of the refused particles' cells: eqs. 7-8 with `R` from the wanted
+/// cell back towards the refused particle's, if it was closing in, then the
+/// clamp to `scale` quanta. `mass` holds each cell's mass, by the cell the
+/// particle started in. Out of line, one copy for both velocity widths:
+/// only worlds with contacts come here, and they pay one call a block.
+#[inline(never)]
+fn contacts<const D: usize, const CELLS: usize>(
+    sh: &Shared<'_>,
+    b: &mut Block<D, CELLS>,
+    want: &[u8; CELLS],
+    targets: u32,
+    mass: &[f32; CELLS],
+    scale: f32,
+    counters: &mut Counters,
+) {
+    let equal = !sh.desc.per_particle_mass;
+    for a in cells_of(b.occ) {
+        let wanted = a ^ usize::from(want[a]);
+        if want[a] == 0 || (targets >> (4 * a) & 7) as usize == wanted {
+            continue;
+        }
+        // The particle placed in the wanted cell, if any.
+        let Some(h) = cells_of(b.occ).find(|&h| (targets >> (4 * h) & 7) as usize == wanted) else { continue };
+        let r = back_normal::<D>(a, wanted);
+        let (xa, xh) = (b.velocity(a), b.velocity(h));
+        if dot([xa[0] - xh[0], xa[1] - xh[1], xa[2] - xh[2]], r) >= 0.0 {
+            continue;
+        }
+        let (ma, mh) = (mass[a], mass[h]);
+        let s = if equal { (0.5, 0.5) } else { shares(ma, mh) };
+        let (mut ya, mut yh) = collide_pair::<D>(xa, xh, s, sh.desc.restitution, r);
+        if sh.desc.energy_neutral {
+            (ya, yh) = energy_neutral::<D>(ya, yh, s);
+        }
+        clamp_counted::<D>(&mut ya, scale, ma, counters);
+        clamp_counted::<D>(&mut yh, scale, mh, counters);
+        b.set(a, ya);
+        b.set(h, yh);
+    }
 }
 
 /// A block's particles as the stages of M5 see them.
@@ -381,6 +528,13 @@ impl<const D: usize, const CELLS: usize> Block<D, CELLS> {
         }
         self.dirty |= self.pending;
         self.pending = 0;
+    }
+
+    /// [`Block::round`] out of line, after the stages that seldom change a
+    /// velocity: a reflection (M5.4) and contacts (M5.7).
+    #[inline(never)]
+    fn round_apart<Q: Quant>(&mut self, rng: &mut Stream) {
+        self.round::<Q>(rng);
     }
 }
 
@@ -509,62 +663,6 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
         m & inward
     }
 
-    /// M5.4: the particle in cell `c` of mass `m` wants the blocked cell
-    /// `to`: reflect its velocity off that cell's surface (eq. 9) and clamp
-    /// it, or keep it where the surface says the particle is already leaving.
-    /// Either way the caller keeps the particle in its cell this step. Rare,
-    /// so kept out of the block routine's straight line.
-    #[cold]
-    #[inline(never)]
-    fn reflect_off(&mut self, b: &mut Block<D, CELLS>, c: usize, to: Wanted, m: f32, rng: &mut Stream) {
-        let sh = self.shared;
-        let t = to.cell;
-        let mut surface = None;
-        if to.wall {
-            if let Beyond::Wall(n) = resolve(sh.n, &sh.desc.boundary, to.at) {
-                surface = Some((n, sh.desc.wall_restitution));
-            }
-        }
-        let (n, e) = surface.unwrap_or_else(|| match surface_at(sh.surface, to.site as u32) {
-            // Component by component: a copy of the array through the
-            // reference is a `memmove` call at opt-level z, the only one
-            // in a firmware build (1.5 KB of flash).
-            Some(s) => ([s.normal[0], s.normal[1], s.normal[2]], s.restitution),
-            // Unreachable for obstacles added through the API (every cell
-            // next to a free one has an entry): the direction back to the
-            // particle.
-            None => (back_normal::<D>(c, t), sh.desc.wall_restitution),
-        });
-        let x = b.velocity(c);
-        let back = back_normal::<D>(c, t);
-        let n = if dot(x, n) < 0.0 {
-            n
-        } else {
-            // The particle already leaves the surface (N.v >= 0), yet asks
-            // for one of its cells: a stair of a surface tilted against the
-            // grid. Where N faces the particle's cell, the particle is on
-            // the free side of that surface: it keeps its velocity and only
-            // this move is refused, unless no cell along one axis of its
-            // velocity is free, which would leave it stuck (a concave
-            // corner where shapes overlap). Otherwise, or where N does not
-            // face the particle (a half-space seen across a periodic seam, a
-            // mask corner), it would press on the obstacle for ever: reflect
-            // off the face it came through. M5.4.
-            let mut at = to.at;
-            for (k, a) in at.iter_mut().enumerate().take(D) {
-                *a += ((c >> k) & 1) as i64 - ((t >> k) & 1) as i64;
-            }
-            if dot(n, back) > 0.0 && crate::obstacle::axis_move_free(sh.obstacle, sh.n, &sh.desc.boundary, at, x, D) {
-                return;
-            }
-            back
-        };
-        let mut x = reflect(x, n, e); // eq. 9
-        clamp_counted::<D>(&mut x, Q::SCALE, m, &mut self.counters);
-        b.set(c, x);
-        b.round::<Q>(rng);
-    }
-
     /// M5.6: where each particle goes, `targets >> 4c & 7` for the particle
     /// in cell `c`, counting those not placed in their desired cell. `want`
     /// holds the axes each wants to cross (a desired cell is never blocked:
@@ -589,54 +687,22 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
             // 2 bits a cell in the table; 4 here, as in 3D.
             return SPREAD_2D[usize::from(packed as u8)];
         }
-        let mut problem = MoveProblem { free: !blocked & Self::ALL, count: occ.count_ones() as usize, ..MoveProblem::default() };
-        for (i, c) in cells_of(occ).enumerate() {
-            problem.current[i] = c as u8;
-            problem.desired[i] = c as u8 ^ want[c];
-            if method == Method::Greedy {
-                problem.speed2[i] = speed2(c);
+        let cells = (occ, !blocked & Self::ALL);
+        let displaced = &mut self.counters.displaced;
+        // In 2D, a method other than exact-fast is a description's choice
+        // that no scene of the paper makes: one copy, out of line, serves
+        // every 2D routine. In 3D every assignment comes here.
+        if D == 2 {
+            let (mut speeds, mut want4) = ([0.0f32; 4], [0u8; 4]);
+            for c in cells_of(occ) {
+                want4[c] = want[c];
+                if method == Method::Greedy {
+                    speeds[c] = speed2(c);
+                }
             }
+            return solve_block_2d(method, cells, &want4, &speeds, rng, displaced);
         }
-        let moves = assign_moves::<D>(method, &problem, rng);
-        let mut targets = 0u32;
-        for i in 0..problem.count {
-            targets |= u32::from(moves.target[i]) << (4 * problem.current[i]);
-            self.counters.displaced += u64::from(moves.target[i] != problem.desired[i]);
-        }
-        targets
-    }
-
-    /// M5.7: every particle refused the cell it wanted (`want`, by the
-    /// assignment's `targets`) meets the particle that holds that cell,
-    /// in the order of the refused particles' cells: eqs. 7-8 with `R` from
-    /// the wanted cell back towards the refused particle's, if it was
-    /// closing in, then the clamp. `mass` gives a cell's mass, by the cell
-    /// the particle started in.
-    #[inline(always)]
-    fn contacts(&mut self, b: &mut Block<D, CELLS>, want: &[u8; CELLS], targets: u32, mass: impl Fn(usize) -> f32, equal: bool) {
-        for a in cells_of(b.occ) {
-            let wanted = a ^ usize::from(want[a]);
-            if want[a] == 0 || (targets >> (4 * a) & 7) as usize == wanted {
-                continue;
-            }
-            // The particle placed in the wanted cell, if any.
-            let Some(h) = cells_of(b.occ).find(|&h| (targets >> (4 * h) & 7) as usize == wanted) else { continue };
-            let r = back_normal::<D>(a, wanted);
-            let (xa, xh) = (b.velocity(a), b.velocity(h));
-            if dot([xa[0] - xh[0], xa[1] - xh[1], xa[2] - xh[2]], r) >= 0.0 {
-                continue;
-            }
-            let (ma, mh) = (mass(a), mass(h));
-            let s = if equal { (0.5, 0.5) } else { shares(ma, mh) };
-            let (mut ya, mut yh) = collide_pair::<D>(xa, xh, s, self.shared.desc.restitution, r);
-            if self.shared.desc.energy_neutral {
-                (ya, yh) = energy_neutral::<D>(ya, yh, s);
-            }
-            clamp_counted::<D>(&mut ya, Q::SCALE, ma, &mut self.counters);
-            clamp_counted::<D>(&mut yh, Q::SCALE, mh, &mut self.counters);
-            b.set(a, ya);
-            b.set(h, yh);
-        }
+        solve_block::<D, CELLS>(method, cells, want, speed2, rng, displaced)
     }
 
     /// Writes the velocity of the particle of cell `c` to cell `to` of the
@@ -663,7 +729,8 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
     /// lifetimes, no force but a uniform one) away from the faces and
     /// without an obstacle: [`Kernel::general`] without what such a block
     /// cannot have. Cell `c`
-    /// has x `xs[c & 1]` in block row `c >> 1`.
+    /// has x `xs[c & 1]` in block row `c >> 1`; the two are neighbours (the
+    /// block that wraps round a periodic axis goes to the general routine).
     #[inline(always)]
     fn lean(&mut self, row: &BlockRow, xs: [usize; 2], index: u64, occ: u8) {
         let sh = self.shared;
@@ -691,8 +758,8 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
         });
         let targets = self.assign(occ, |c| { let x = b.velocity(c); dot(x, x) }, 0, &want, key, &mut rng);
         if sh.desc.contacts && wanted != 0 {
-            self.contacts(&mut b, &want, targets, |_| mass, true);
-            b.round::<Q>(&mut rng);
+            contacts(sh, &mut b, &want, targets, &[mass; CELLS], Q::SCALE, &mut self.counters);
+            b.round_apart::<Q>(&mut rng);
         }
         self.counters.processed += 1;
         if (targets ^ IDENTITY) & FIELDS[usize::from(occ)] == 0 && b.dirty == 0 {
@@ -978,7 +1045,11 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
             let t = c ^ usize::from(m);
             if m != 0 && blocked >> t & 1 != 0 {
                 let to = Wanted { cell: t, site: cell(t), at: at(t), wall: wall >> t & 1 != 0 };
-                self.reflect_off(&mut b, c, to, mass[c], &mut rng);
+                // M5.4, its new velocity rounded at once (M1).
+                if let Some(x) = reflect_off::<D>(sh, b.velocity(c), c, to, mass[c], Q::SCALE, &mut self.counters) {
+                    b.set(c, x);
+                    b.round_apart::<Q>(&mut rng);
+                }
                 m = 0;
             }
             want[c] = m;
@@ -993,8 +1064,8 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
 
         // M5.7 contacts, then M1 for what they changed.
         if desc.contacts && wanted != 0 {
-            self.contacts(&mut b, &want, targets, |c| mass[c], !desc.per_particle_mass);
-            b.round::<Q>(&mut rng);
+            contacts(sh, &mut b, &want, targets, &mass, Q::SCALE, &mut self.counters);
+            b.round_apart::<Q>(&mut rng);
         }
 
         // Write back what changed.
@@ -1056,11 +1127,13 @@ impl<'a, Q: Quant, const D: usize, const CELLS: usize> BlockSink<'a> for Kernel<
         }
         if sh.plain && row.outside == 0 && x0 >= 0 {
             let x0 = x0 as usize;
-            let x1 = if x0 + 1 < sh.n[0] { Some(x0 + 1) } else { sh.part.axes[0].periodic.then_some(0) };
-            if let Some(x1) = x1 {
+            // The block that wraps round a periodic x axis goes through
+            // the general routine: the lean one reads each block row's two
+            // cells as neighbours.
+            if x0 + 1 < sh.n[0] {
                 // A world with obstacles: only blocks without one are lean.
-                if !sh.desc.obstacles || read_block::<CELLS>(sh.obstacle, row, [x0, x1]) == 0 {
-                    return self.lean(row, [x0, x1], row.index + bx as u64, occ);
+                if !sh.desc.obstacles || read_block::<CELLS>(sh.obstacle, row, [x0, x0 + 1]) == 0 {
+                    return self.lean(row, [x0, x0 + 1], row.index + bx as u64, occ);
                 }
             }
         }

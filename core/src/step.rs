@@ -15,10 +15,10 @@ use crate::kernel::{Kernel, Shared, Writable};
 use crate::partition::Partition;
 use crate::quant::Quant;
 use crate::rng::StepKey;
-use crate::layout::{groups, Planes};
+use crate::layout::{groups, view, Planes};
 #[cfg(target_has_atomic = "8")]
 use crate::tasks::Host;
-use crate::world::{Counters, World};
+use crate::world::{Counters, Header, World};
 
 /// The block order of a step. Blocks are independent (M3, M8); the reverse
 /// order exists so tests can show that the result does not depend on it.
@@ -150,15 +150,27 @@ impl World {
 
     /// Runs `visit` over the step's partition with the step's shared data and
     /// the writable planes, and adds the counters it returns to the world's.
+    /// Only the velocity plane's view depends on the width: the rest is set
+    /// up and counted once for every width ([`World::setup`]).
     pub(crate) fn sweep_with<Q: Quant, const D: usize>(
         &mut self,
         route: Route,
         visit: impl FnOnce(&Shared<'_>, Writable<'_, Q, D>, bool) -> Counters,
     ) {
+        let Setup { head, shared, velocity, occupancy, rows, words, mass_index, life } = self.setup(route, Q::SCALE);
+        let planes = Writable { occupancy, rows, words, velocity: Cells::new(groups(view::<Q>(velocity))), mass_index, life };
+        let c = visit(&shared, planes, route.reverse);
+        head.count_step(&c, shared.part.total_blocks());
+    }
+
+    /// A step's [`Setup`] for a velocity width of `scale` quanta per unit
+    /// speed. Out of line: one copy serves every width and dimension.
+    #[inline(never)]
+    fn setup(&mut self, route: Route, scale: f32) -> Setup<'_> {
         let part = Partition::new(self.layout(), &self.head.desc.boundary, self.dim(), self.head.step);
         let periodic = self.periodic();
         let dim = self.dim();
-        let (head, p) = self.planes::<Q>();
+        let (head, p) = self.planes::<u8>();
         let desc = head.desc;
         let Layout { n, .. } = head.layout;
         let Planes { occupancy, rows, words, obstacle, velocity, mass_index, life, field, potential, wind, mass_table, surface, .. } = p;
@@ -171,7 +183,7 @@ impl World {
             periodic,
             dim,
         };
-        let dt_q = desc.dt * Q::SCALE;
+        let dt_q = desc.dt * scale;
         let push = terms.gravity.map(|g| if dt_q == 0.0 { 0.0 } else { g * dt_q });
         // Fields, potentials, the vortex and drag are summed per particle;
         // a uniform force alone is one precomputed change (`push`).
@@ -189,10 +201,10 @@ impl World {
             terms,
             dt_q,
             drag: (desc.drag.rate > 0.0).then(|| Flow {
-                wind: desc.drag.wind.map(|w| w * Q::SCALE),
+                wind: desc.drag.wind.map(|w| w * scale),
                 field: desc.drag.field.then_some(&*wind),
                 vortex: desc.drag.vortex.then_some(desc.vortex),
-                scale: Q::SCALE,
+                scale,
                 dim,
                 rate: desc.dt * desc.drag.rate,
             }),
@@ -201,20 +213,43 @@ impl World {
             plain,
             lanes: plain && !desc.contacts,
         };
-        let planes = Writable {
+        Setup {
+            head,
+            shared,
+            velocity,
             occupancy: Cells::new(occupancy),
             rows: Cells::new(rows),
             words: Cells::new(words),
-            velocity: Cells::new(groups(velocity)),
             mass_index: Cells::new(mass_index),
             life: Cells::new(life),
-        };
-        let c = visit(&shared, planes, route.reverse);
-        let h = &mut head.counters;
-        h.add_step(&c);
+        }
+    }
+}
+
+/// A step set up for its sweep, whatever its velocity width: the data every
+/// block reads, the planes blocks write but the velocities (as bytes: the
+/// width's routine views them as its own type) and the header the step's
+/// counters go to.
+struct Setup<'a> {
+    head: &'a mut Header,
+    shared: Shared<'a>,
+    velocity: &'a mut [u8],
+    occupancy: Cells<'a, u64>,
+    rows: Cells<'a, u8>,
+    words: Cells<'a, u64>,
+    mass_index: Cells<'a, u8>,
+    life: Cells<'a, u16>,
+}
+
+impl Header {
+    /// Adds a step's counters `c` to the world's; the partition had `total`
+    /// blocks.
+    fn count_step(&mut self, c: &Counters, total: u64) {
+        let h = &mut self.counters;
+        h.add_step(c);
         h.particles -= c.exited + c.expired;
         h.processed = c.processed;
-        h.skipped = part.total_blocks() - c.processed;
+        h.skipped = total - c.processed;
     }
 }
 

@@ -45,16 +45,17 @@ pub(crate) fn clamp_of<const D: usize>(v: &mut [f32; 3], limit: f32) -> Option<f
     if s2 <= limit * limit {
         return None;
     }
-    // By value: a velocity whose address never escapes stays in registers.
     let (w, s2) = clamp_long(*v, s2, limit);
     *v = w;
     Some(s2)
 }
 
-/// The part of [`clamp`] that runs only when it clamps: the clamped
-/// velocity and the squared length it had.
+/// The part of [`clamp`] that runs only when it clamps: `s2` is the squared
+/// length of `v`, more than `limit` squared (or NaN); the clamped velocity
+/// and `s2` (infinity where `v` overflowed) come back. By value: a velocity
+/// whose address never escapes stays in registers.
 #[cold]
-fn clamp_long(mut v: [f32; 3], s2: f32, limit: f32) -> ([f32; 3], f32) {
+pub(crate) fn clamp_long(mut v: [f32; 3], s2: f32, limit: f32) -> ([f32; 3], f32) {
     let v = &mut v;
     if !s2.is_finite() {
         // In units of the limit, so that "short enough" means length <= 1.
