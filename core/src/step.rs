@@ -170,8 +170,8 @@ impl World {
         let part = Partition::new(self.layout(), &self.head.desc.boundary, self.dim(), self.head.step);
         let periodic = self.periodic();
         let dim = self.dim();
+        let desc = self.head.desc;
         let (head, p) = self.planes::<u8>();
-        let desc = head.desc;
         let Layout { n, .. } = head.layout;
         let Planes { occupancy, rows, words, obstacle, velocity, mass_index, life, field, potential, wind, mass_table, surface, .. } = p;
         let terms = ForceTerms {
