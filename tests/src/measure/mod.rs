@@ -8,6 +8,7 @@
 //! on every run; only the run times vary, and those are the median (with the
 //! spread) of several runs.
 
+pub mod additions;
 pub mod assignment;
 pub mod conservation;
 pub mod cooling;

@@ -357,11 +357,12 @@ pub fn report(h: &Header, r: &Results, tables: &[Table]) -> String {
     );
     s += "## Summary\n\n";
     s += &summary(&headline(r));
+    s += &additions_line(r);
     s += "\n![error against run time](error-vs-time.svg)\n\n";
     s += "Each panel: one point per method and setting; the dashed staircase is the Pareto front (no other setting is \
           both faster and more accurate than a point on it; those are starred in the legend). A zero error is drawn on \
           the row marked 0 below the log axis.\n\n";
-    let sections: [(&str, &[&str]); 8] = [
+    let sections: [(&str, &[&str]); 9] = [
         ("Drift error (M5.3)", &["drift_summary", "drift_by_speed"]),
         ("Assignment error (M5.6)", &["assignment_summary", "assignment_by_k"]),
         ("The paper's scenes", &["scene_aggregation", "scene_cluster", "scene_smoke", "scene_water"]),
@@ -370,6 +371,7 @@ pub fn report(h: &Header, r: &Results, tables: &[Table]) -> String {
         ("Obstacle fidelity", &["reflection_summary", "reflection_by_angle", "sliding", "inside_obstacles"]),
         ("Quantization", &["quantization"]),
         ("Leave out what the scene does not need", &["leave_out"]),
+        ("The rules beyond the paper", &["additions"]),
     ];
     let details = ["drift_by_speed", "assignment_by_k", "reflection_by_angle"];
     for (title, keys) in sections {
@@ -386,6 +388,17 @@ pub fn report(h: &Header, r: &Results, tables: &[Table]) -> String {
         }
     }
     s
+}
+
+/// The rules beyond the paper, each figure under the paper's rule and with
+/// the rule (the `additions` table).
+fn additions_line(r: &Results) -> String {
+    let figures: Vec<String> =
+        r.additions.iter().map(|a| format!("{} ({}): {} {} → {}", a.rule, a.scenes, a.measure, sig(a.paper), sig(a.addition))).collect();
+    if figures.is_empty() {
+        return String::new();
+    }
+    format!("- **The rules beyond the paper**, paper rule → with the rule: {}.\n", figures.join("; "))
 }
 
 /// report.json's header: how, where and when the figures were made.

@@ -1,6 +1,7 @@
 //! Runs every measurement of the report, sized by the mode.
 
 use mpca::{Method, Quantization};
+use mpca_tests::measure::additions::{self, AdditionRow};
 use mpca_tests::measure::assignment::{self, AssignRow, AssignSummary};
 use mpca_tests::measure::conservation::{self, BoxConfig, BoxResult};
 use mpca_tests::measure::cooling::{self, CoolingConfig, CoolingResult};
@@ -39,6 +40,9 @@ pub struct Config {
     pub scene_share: f64,
     /// Timed runs of the leave-out comparison.
     pub leave_out_runs: usize,
+    /// Steps of the elastic box of M1b (the other additions run `scene_share`
+    /// of their scenes' steps, once each).
+    pub elastic_steps: u64,
 }
 
 impl Config {
@@ -58,6 +62,7 @@ impl Config {
             inside_steps: 100,
             scene_share: 0.25,
             leave_out_runs: 3,
+            elastic_steps: 1000,
         }
     }
 
@@ -77,6 +82,7 @@ impl Config {
             inside_steps: 500,
             scene_share: 1.0,
             leave_out_runs: 7,
+            elastic_steps: 20_000,
         }
     }
 }
@@ -104,6 +110,8 @@ pub struct Results {
     pub inside: Vec<InsideRow>,
     /// Leave out what the scene does not need.
     pub leave_out: Vec<LeaveOutRow>,
+    /// The rules beyond the paper against the paper's.
+    pub additions: Vec<AdditionRow>,
 }
 
 fn say(what: &str) {
@@ -194,5 +202,8 @@ pub fn all(cfg: &Config) -> Results {
         leave_out.extend(scenes::leave_out(&scene, steps, cfg.leave_out_runs));
     }
 
-    Results { drift, assign, assign_summary, scenes: scene_rows, boxes, cooling, reflect, slide, inside, leave_out }
+    say("the rules beyond the paper against the paper's");
+    let additions = additions::measure(cfg.scene_share, cfg.elastic_steps, 1);
+
+    Results { drift, assign, assign_summary, scenes: scene_rows, boxes, cooling, reflect, slide, inside, leave_out, additions }
 }

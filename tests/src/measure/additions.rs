@@ -1,0 +1,177 @@
+//! The rules beyond the paper (docs/model.md, "Additions"), each against
+//! the paper's rule on the scene where the difference shows (M10): flow
+//! drag on the smoke, speed-limited collisions on the e = 1 cluster,
+//! contacts on the poured water pool, energy-neutral rounding in an
+//! elastic 8-bit box. The figures are those the tests of
+//! `tests/tests/effects.rs` hold to their bounds, here with run times.
+
+use mpca::{Boundary, Collisions, Description, World};
+
+use super::{memory, repeat, run_steps, SetupRng, Timing};
+use crate::scenes::{self, Scene};
+
+/// One figure of one rule: its value under the paper's rule and under the
+/// addition, and the run times of both.
+pub struct AdditionRow {
+    /// The rule, as docs/model.md names it.
+    pub rule: &'static str,
+    /// The paper's scene (or world) and the one with the addition.
+    pub scenes: String,
+    /// What is measured.
+    pub measure: &'static str,
+    /// The figure under the paper's rule.
+    pub paper: f64,
+    /// The figure with the addition.
+    pub addition: f64,
+    /// Steps of each run: the paper's, the addition's.
+    pub steps: (u64, u64),
+    /// Run time of the steps under the paper's rule.
+    pub paper_timing: Timing,
+    /// Run time of the steps with the addition.
+    pub addition_timing: Timing,
+}
+
+/// What a run of a scene ends with.
+struct Ended {
+    clamps_per_particle_step: f64,
+    mean_speed: f64,
+    energy_change: f64,
+    clamps: f64,
+}
+
+/// Builds `scene`, steps it `steps` times one at a time (only the steps
+/// are timed) and reads what [`Ended`] holds.
+fn run(scene: &Scene, steps: u64, runs: usize) -> (Ended, Timing) {
+    repeat(runs, || {
+        let mut mem = Vec::new();
+        let w = scenes::build(scene, &mut mem).expect("the scene builds");
+        step_and_read(w, steps)
+    })
+}
+
+/// Steps `w` `steps` times, one at a time (only the steps timed), and reads
+/// what [`Ended`] holds; the seconds spent stepping.
+fn step_and_read(w: &mut World, steps: u64) -> (Ended, f64) {
+    let e0 = w.stats().kinetic_energy;
+    let mut particle_steps = 0u64;
+    let seconds = run_steps(w, steps, |w, _| particle_steps += w.particle_count());
+    let s = w.stats();
+    let n = w.particle_count().max(1) as f64;
+    let mean_speed = w.particles().map(|p| f64::from(p.velocity.iter().map(|c| c * c).sum::<f32>().sqrt())).sum::<f64>() / n;
+    let ended = Ended {
+        clamps_per_particle_step: s.clamps as f64 / particle_steps.max(1) as f64,
+        mean_speed,
+        energy_change: s.kinetic_energy / e0 - 1.0,
+        clamps: s.clamps as f64,
+    };
+    (ended, seconds)
+}
+
+/// The figures `figures` of the pair of runs `(paper, addition)`.
+fn rows(
+    rule: &'static str,
+    scenes: String,
+    figures: &[(&'static str, fn(&Ended) -> f64)],
+    paper: (Ended, Timing),
+    addition: (Ended, Timing),
+    steps: (u64, u64),
+) -> Vec<AdditionRow> {
+    figures
+        .iter()
+        .map(|&(measure, f)| AdditionRow {
+            rule,
+            scenes: scenes.clone(),
+            measure,
+            paper: f(&paper.0),
+            addition: f(&addition.0),
+            steps,
+            paper_timing: paper.1.clone(),
+            addition_timing: addition.1.clone(),
+        })
+        .collect()
+}
+
+/// The elastic 8-bit gas of the M1b test: 128^2 cells with walls, density
+/// 0.3, speeds up to 0.6, speed-limited collisions (no clamp), e = 1.
+fn elastic_box(energy_neutral: bool) -> Description {
+    let mut desc = Description::new_2d(128, 128).with_boundary(Boundary::Wall);
+    desc.collisions = Collisions::SpeedLimited;
+    desc.energy_neutral = energy_neutral;
+    desc.seed = 12;
+    desc
+}
+
+fn elastic_run(energy_neutral: bool, steps: u64, runs: usize) -> (Ended, Timing) {
+    let desc = elastic_box(energy_neutral);
+    let mut mem = memory(&desc);
+    repeat(runs, || {
+        let w = World::init(&desc, &mut mem).expect("fits");
+        let mut rng = SetupRng::new(4);
+        for pos in super::cells(&desc) {
+            if rng.unit() < 0.3 {
+                let v = rng.velocity(2, 0.6);
+                w.add_particle(pos, v).expect("a free cell");
+            }
+        }
+        step_and_read(w, steps)
+    })
+}
+
+/// Every rule, `share` of each scene's steps (the elastic box `box_steps`),
+/// each run timed `runs` times.
+pub fn measure(share: f64, box_steps: u64, runs: usize) -> Vec<AdditionRow> {
+    let steps = |n: u64| ((n as f64 * share).round() as u64).max(1);
+    let mut out = vec![];
+
+    // M5.1b: the paper's vortex force against drag towards the flow.
+    let (smoke, flow) = (scenes::smoke(), scenes::smoke_flow());
+    let (a, b) = (steps(480), steps(flow.steps));
+    out.extend(rows(
+        "M5.1b flow drag",
+        format!("{} / {}", smoke.name, flow.name),
+        &[("clamps per particle-step", |e| e.clamps_per_particle_step), ("mean speed at the end", |e| e.mean_speed)],
+        run(&smoke, a, runs),
+        run(&flow, b, runs),
+        (a, b),
+    ));
+
+    // M5.2b: the e = 1 cluster collision, paper collisions against
+    // speed-limited ones.
+    let paper = scenes::cluster();
+    let mut limited = scenes::cluster();
+    limited.desc.collisions = Collisions::SpeedLimited;
+    let n = steps(paper.steps);
+    out.extend(rows(
+        "M5.2b speed-limited collisions",
+        format!("{} (e = 1)", paper.name),
+        &[("kinetic energy, relative change", |e| e.energy_change), ("clamps", |e| e.clamps)],
+        run(&paper, n, runs),
+        run(&limited, n, runs),
+        (n, n),
+    ));
+
+    // M5.7: the poured water pool without and with contacts.
+    let with = scenes::water_pool();
+    let mut without = scenes::water_pool();
+    without.desc.contacts = false;
+    let n = steps(with.steps);
+    out.extend(rows(
+        "M5.7 contacts",
+        format!("{} (e = 0.5)", with.name),
+        &[("mean speed at the end", |e| e.mean_speed), ("clamps per particle-step", |e| e.clamps_per_particle_step)],
+        run(&without, n, runs),
+        run(&with, n, runs),
+        (n, n),
+    ));
+
+    // M1b: the elastic box, unbiased rounding against energy-neutral.
+    out.extend(rows(
+        "M1b energy-neutral rounding",
+        "elastic 8-bit box, 128² (e = 1)".into(),
+        &[("kinetic energy, relative change", |e| e.energy_change)],
+        elastic_run(false, box_steps, runs),
+        elastic_run(true, box_steps, runs),
+        (box_steps, box_steps),
+    ));
+    out
+}
