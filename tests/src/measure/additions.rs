@@ -67,11 +67,14 @@ fn step_and_read(w: &mut World, steps: u64) -> (Ended, f64) {
     (ended, seconds)
 }
 
+/// A figure of a run: its name and how it is read.
+type Figure = (&'static str, fn(&Ended) -> f64);
+
 /// The figures `figures` of the pair of runs `(paper, addition)`.
 fn rows(
     rule: &'static str,
     scenes: String,
-    figures: &[(&'static str, fn(&Ended) -> f64)],
+    figures: &[Figure],
     paper: (Ended, Timing),
     addition: (Ended, Timing),
     steps: (u64, u64),
