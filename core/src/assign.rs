@@ -790,23 +790,50 @@ impl Prices {
         if price < i16::from(PRIMARY) {
             return 1 << at;
         }
-        // A mask from a compare of all eight lanes: one vector compare and
-        // a move of its sign bits where the target has them.
-        let mut cells = 0u8;
-        for t in 0..MAX_CELLS {
-            cells |= u8::from(costs[t] + self.lift[t] == price) << t;
-        }
-        cells
+        // -1 in the lanes of the tight cells: one vector compare.
+        sign_mask(&core::array::from_fn(|t| i16::from(costs[t] + self.lift[t] == price).wrapping_neg()))
     }
 
     /// The cells every optimal assignment fills: those with lift.
     fn must(&self) -> u8 {
-        let mut cells = 0u8;
-        for t in 0..MAX_CELLS {
-            cells |= u8::from(self.lift[t] > 0) << t;
-        }
-        cells
+        sign_mask(&core::array::from_fn(|t| i16::from(self.lift[t] > 0).wrapping_neg()))
     }
+}
+
+/// The lanes that are negative, as a mask (bit `t` for lane `t`): a pack
+/// of the lanes to bytes and a move of their sign bits with SSE2, which
+/// every x86-64 has, where the compiler would otherwise gather the bits one
+/// at a time.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+fn sign_mask(lanes: &Lanes) -> u8 {
+    use core::arch::x86_64::{_mm_loadu_si128, _mm_movemask_epi8, _mm_packs_epi16};
+    // SAFETY: SSE2 is part of every x86-64 target; `Lanes` is 16 bytes, all
+    // of which the unaligned load reads. Packing saturates, so each byte
+    // keeps its lane's sign; the low eight bits of the move are the lanes'.
+    unsafe {
+        let v = _mm_loadu_si128(lanes.as_ptr().cast());
+        _mm_movemask_epi8(_mm_packs_epi16(v, v)) as u8
+    }
+}
+
+/// The lanes that are negative, as a mask (bit `t` for lane `t`).
+#[cfg(not(target_arch = "x86_64"))]
+#[inline(always)]
+fn sign_mask(lanes: &Lanes) -> u8 {
+    sign_bits(lanes)
+}
+
+/// [`sign_mask`] a lane at a time: what other targets use, and what the
+/// tests hold the SSE2 one to.
+#[cfg(any(test, not(target_arch = "x86_64")))]
+#[inline(always)]
+fn sign_bits(lanes: &Lanes) -> u8 {
+    let mut cells = 0u8;
+    for (t, &lane) in lanes.iter().enumerate() {
+        cells |= u8::from(lane < 0) << t;
+    }
+    cells
 }
 
 /// The least of eight lanes, halving the width each step.
@@ -1712,6 +1739,23 @@ mod tests {
         problem.current[..current.len()].copy_from_slice(current);
         problem.desired[..desired.len()].copy_from_slice(desired);
         problem
+    }
+
+    #[test]
+    fn sign_mask_is_the_lanes_signs() {
+        // Every pattern of signs, each lane's magnitude from a stream (0 is
+        // not negative; -1 and i16::MIN are), against the lane-by-lane mask.
+        let mut rng = block_stream(5, 0, 0);
+        for pattern in 0..=255u8 {
+            for _ in 0..8 {
+                let lanes: Lanes = core::array::from_fn(|t| {
+                    let size = (rng.bits(16) as i16) & i16::MAX;
+                    if pattern >> t & 1 != 0 { -1 - size } else { size }
+                });
+                assert_eq!(sign_mask(&lanes), pattern, "{lanes:?}");
+                assert_eq!(sign_bits(&lanes), pattern, "{lanes:?}");
+            }
+        }
     }
 
     #[test]
