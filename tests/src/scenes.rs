@@ -7,6 +7,8 @@ use mpca::{Boundary, Description, Drift, Emitter, Error, Method, Quantization, S
 use rand_core::Rng;
 use rand_pcg::Pcg32;
 
+use crate::setup::{cells, SetupRng};
+
 /// One of the paper's scenes.
 #[derive(Clone, Copy, Debug)]
 pub struct Scene {
@@ -286,6 +288,31 @@ pub fn wide_gas() -> Scene {
     desc.restitution = 0.5;
     desc.seed = 43;
     Scene { name: "gas-1024-full", section: "-", desc, steps: 50, paper_seconds: f64::NAN, setup: |w| fill_gas(w, 1024, 1024) }
+}
+
+/// The elastic 8-bit box of M1b's test and report row: 128 x 128 cells with
+/// `boundary` on every face (walls reflect along the axes exactly),
+/// speed-limited collisions (M5.2b, so no clamp changes momentum), e = 1,
+/// unbiased or energy-neutral rounding. [`fill_elastic`] fills it.
+pub fn elastic_box(energy_neutral: bool, boundary: Boundary) -> Description {
+    let mut desc = Description::new_2d(128, 128).with_boundary(boundary);
+    desc.collisions = mpca::Collisions::SpeedLimited;
+    desc.energy_neutral = energy_neutral;
+    desc.seed = 12;
+    desc
+}
+
+/// The elastic box's gas: a particle in each cell with probability 0.3
+/// (4,898 of them), speeds up to 0.6.
+pub fn fill_elastic(w: &mut World) {
+    let desc = *w.description();
+    let mut rng = SetupRng::new(4);
+    for pos in cells(&desc) {
+        if rng.unit() < 0.3 {
+            let v = rng.velocity(2, 0.6);
+            w.add_particle(pos, v).expect("a free cell, |v| <= 0.6");
+        }
+    }
 }
 
 /// All four, in the paper's order.

@@ -186,26 +186,10 @@ fn contacts_keep_momentum_up_to_rounding() {
 }
 
 
-/// An elastic 8-bit gas of 4,898 particles in a 128^2 box with walls (axis
-/// walls reflect exactly, speed-limited collisions never clamp), so that
-/// only the rounding of collided velocities changes its energy.
+/// The elastic box ([`scenes::elastic_box`]) and memory for it.
 fn elastic_box(energy_neutral: bool, boundary: Boundary) -> (Vec<u8>, Description) {
-    let mut desc = Description::new_2d(128, 128).with_boundary(boundary);
-    desc.collisions = Collisions::SpeedLimited;
-    desc.energy_neutral = energy_neutral;
-    desc.seed = 12;
+    let desc = scenes::elastic_box(energy_neutral, boundary);
     (vec![0u8; mpca::world_bytes(&desc).unwrap()], desc)
-}
-
-fn fill_elastic(w: &mut World) {
-    let desc = *w.description();
-    let mut rng = mpca_tests::setup::SetupRng::new(4);
-    for pos in mpca_tests::setup::cells(&desc) {
-        if rng.unit() < 0.3 {
-            let v = rng.velocity(2, 0.6);
-            w.add_particle(pos, v).unwrap();
-        }
-    }
 }
 
 /// M1b. Unbiased rounding adds `f (1 - f)` quanta^2 per rounded component
@@ -224,7 +208,7 @@ fn energy_neutral_rounding_keeps_an_elastic_box_from_heating() {
     for (i, neutral) in [false, true].into_iter().enumerate() {
         let (mut memory, desc) = elastic_box(neutral, Boundary::Wall);
         let w = World::init(&desc, &mut memory).unwrap();
-        fill_elastic(w);
+        scenes::fill_elastic(w);
         let (n, e0) = (w.particle_count() as f64, w.stats().kinetic_energy);
         w.step(STEPS);
         let s = w.stats();
@@ -245,7 +229,7 @@ fn energy_neutral_rounding_keeps_an_elastic_box_from_heating() {
 fn energy_neutral_rounding_keeps_momentum_up_to_rounding() {
     let (mut memory, desc) = elastic_box(true, Boundary::Periodic);
     let w = World::init(&desc, &mut memory).unwrap();
-    fill_elastic(w);
+    scenes::fill_elastic(w);
     let before = w.stats();
     w.step(2_000);
     let after = w.stats();

@@ -5,9 +5,9 @@
 //! elastic 8-bit box. The figures are those the tests of
 //! `tests/tests/effects.rs` hold to their bounds, here with run times.
 
-use mpca::{Boundary, Collisions, Description, World};
+use mpca::{Boundary, Collisions, World};
 
-use super::{memory, repeat, run_steps, SetupRng, Timing};
+use super::{memory, repeat, run_steps, Timing};
 use crate::scenes::{self, Scene};
 
 /// One figure of one rule: its value under the paper's rule and under the
@@ -94,28 +94,12 @@ fn rows(
         .collect()
 }
 
-/// The elastic 8-bit gas of the M1b test: 128^2 cells with walls, density
-/// 0.3, speeds up to 0.6, speed-limited collisions (no clamp), e = 1.
-fn elastic_box(energy_neutral: bool) -> Description {
-    let mut desc = Description::new_2d(128, 128).with_boundary(Boundary::Wall);
-    desc.collisions = Collisions::SpeedLimited;
-    desc.energy_neutral = energy_neutral;
-    desc.seed = 12;
-    desc
-}
-
 fn elastic_run(energy_neutral: bool, steps: u64, runs: usize) -> (Ended, Timing) {
-    let desc = elastic_box(energy_neutral);
+    let desc = scenes::elastic_box(energy_neutral, Boundary::Wall);
     let mut mem = memory(&desc);
     repeat(runs, || {
         let w = World::init(&desc, &mut mem).expect("fits");
-        let mut rng = SetupRng::new(4);
-        for pos in super::cells(&desc) {
-            if rng.unit() < 0.3 {
-                let v = rng.velocity(2, 0.6);
-                w.add_particle(pos, v).expect("a free cell");
-            }
-        }
+        scenes::fill_elastic(w);
         step_and_read(w, steps)
     })
 }
