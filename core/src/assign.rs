@@ -817,16 +817,32 @@ fn sign_mask(lanes: &Lanes) -> u8 {
     }
 }
 
+/// The lanes that are negative, as a mask (bit `t` for lane `t`): with
+/// Neon, which every AArch64 has, a compare of the lanes with 0, a narrow
+/// to bytes, each byte's own bit kept and the bytes added across.
+#[cfg(target_arch = "aarch64")]
+#[inline(always)]
+fn sign_mask(lanes: &Lanes) -> u8 {
+    use core::arch::aarch64::{vaddv_u8, vand_u8, vcltzq_s16, vcreate_u8, vld1q_s16, vmovn_u16};
+    // SAFETY: Neon is part of every AArch64 target; the load reads the 16
+    // bytes of `Lanes`. The narrowed compare is 0xff or 0 a byte, so after
+    // the mask byte t holds bit t alone, and the sum is their union.
+    unsafe {
+        let negative = vmovn_u16(vcltzq_s16(vld1q_s16(lanes.as_ptr())));
+        vaddv_u8(vand_u8(negative, vcreate_u8(0x8040_2010_0804_0201)))
+    }
+}
+
 /// The lanes that are negative, as a mask (bit `t` for lane `t`).
-#[cfg(not(target_arch = "x86_64"))]
+#[cfg(not(any(target_arch = "x86_64", target_arch = "aarch64")))]
 #[inline(always)]
 fn sign_mask(lanes: &Lanes) -> u8 {
     sign_bits(lanes)
 }
 
 /// [`sign_mask`] a lane at a time: what other targets use, and what the
-/// tests hold the SSE2 one to.
-#[cfg(any(test, not(target_arch = "x86_64")))]
+/// tests hold the vector ones to.
+#[cfg(any(test, not(any(target_arch = "x86_64", target_arch = "aarch64"))))]
 #[inline(always)]
 fn sign_bits(lanes: &Lanes) -> u8 {
     let mut cells = 0u8;
