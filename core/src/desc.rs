@@ -230,6 +230,21 @@ impl Description {
     pub fn validate(&self) -> Result<(), Error> {
         Layout::of(self).map(|_| ())
     }
+
+    /// `per_particle_mass`, false by construction in a build without the
+    /// feature `mass` ([`Layout::of`] refuses it there): the step and the
+    /// edits test this, so such a build holds no code for masses.
+    #[inline(always)]
+    pub(crate) const fn has_masses(&self) -> bool {
+        cfg!(feature = "mass") && self.per_particle_mass
+    }
+
+    /// `obstacles`, false by construction in a build without the feature
+    /// `obstacles`, as [`Description::has_masses`].
+    #[inline(always)]
+    pub(crate) const fn has_obstacles(&self) -> bool {
+        cfg!(feature = "obstacles") && self.obstacles
+    }
 }
 
 pub(crate) fn finite(values: &[f32]) -> Result<(), Error> {

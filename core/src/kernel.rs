@@ -458,7 +458,7 @@ fn contacts<const D: usize, const CELLS: usize>(
     scale: f32,
     counters: &mut Counters,
 ) {
-    let equal = !sh.desc.per_particle_mass;
+    let equal = !sh.desc.has_masses();
     for a in cells_of(b.occ) {
         let wanted = a ^ usize::from(want[a]);
         if want[a] == 0 || (targets >> (4 * a) & 7) as usize == wanted {
@@ -980,14 +980,14 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
                 _ => open |= 1 << c,
             }
         }
-        let blocked = wall | if desc.obstacles { read_block::<CELLS>(sh.obstacle, row, xs) & !outside & Self::ALL } else { 0 };
+        let blocked = wall | if desc.has_obstacles() { read_block::<CELLS>(sh.obstacle, row, xs) & !outside & Self::ALL } else { 0 };
 
         let mut b = self.load(row, xs, occ);
         let mut mass = [desc.mass; CELLS];
         let mut mass_index = [0u8; CELLS];
         let mut life = [0u16; CELLS];
         for c in cells_of(occ) {
-            if desc.per_particle_mass {
+            if desc.has_masses() {
                 mass_index[c] = self.planes.mass_index.get(cell(c));
                 mass[c] = sh.mass_table[usize::from(mass_index[c])];
             }
@@ -1032,7 +1032,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
 
         // M5.2 collision, then M1 for what the force, the drag and the
         // collision changed.
-        self.collide(&mut b, &mut rng, |c| mass[c], !desc.per_particle_mass);
+        self.collide(&mut b, &mut rng, |c| mass[c], !desc.has_masses());
         b.round::<Q>(&mut rng);
 
         // M5.3 desired move, M5.4 obstacle reflection: `want[c]` holds the
@@ -1087,7 +1087,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
                 if t != c || b.dirty >> c & 1 != 0 {
                     self.store(&b, c, to);
                 }
-                if desc.per_particle_mass && t != c {
+                if desc.has_masses() && t != c {
                     self.planes.mass_index.set(to, mass_index[c]);
                 }
                 if desc.lifetimes {
@@ -1120,7 +1120,7 @@ impl<'a, Q: Quant, const D: usize, const CELLS: usize> BlockSink<'a> for Kernel<
             // test on x (n >= 1: Layout::of refuses an empty axis).
             let x = x0 as usize;
             let pairwise = sh.lanes && row.outside == 0 && x < sh.n[0] - 1;
-            if pairwise && (!sh.desc.obstacles || read_block::<CELLS>(sh.obstacle, row, [x, x + 1]) == 0) {
+            if pairwise && (!sh.desc.has_obstacles() || read_block::<CELLS>(sh.obstacle, row, [x, x + 1]) == 0) {
                 return self.lean_2d(row, x, row.index + bx as u64, occ);
             }
             return self.general(row, x0, bx, occ);
@@ -1132,7 +1132,7 @@ impl<'a, Q: Quant, const D: usize, const CELLS: usize> BlockSink<'a> for Kernel<
             // cells as neighbours.
             if x0 + 1 < sh.n[0] {
                 // A world with obstacles: only blocks without one are lean.
-                if !sh.desc.obstacles || read_block::<CELLS>(sh.obstacle, row, [x0, x0 + 1]) == 0 {
+                if !sh.desc.has_obstacles() || read_block::<CELLS>(sh.obstacle, row, [x0, x0 + 1]) == 0 {
                     return self.lean(row, [x0, x0 + 1], row.index + bx as u64, occ);
                 }
             }

@@ -109,7 +109,7 @@ impl World {
     }
 
     pub(crate) fn mass_at(&self, cell: usize) -> f32 {
-        if self.head.desc.per_particle_mass {
+        if self.head.desc.has_masses() {
             let idx: &[u8] = self.plane(self.layout().mass_index);
             let table: &[f32] = self.plane(self.layout().mass_table);
             table[usize::from(idx[cell])]

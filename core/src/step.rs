@@ -188,7 +188,7 @@ impl World {
         // Fields, potentials, the vortex and drag are summed per particle;
         // a uniform force alone is one precomputed change (`push`).
         let summed = cfg!(feature = "fields") && (desc.forces.any_field() || desc.drag.rate > 0.0);
-        let plain = route.lean && !desc.per_particle_mass && !desc.lifetimes && !summed;
+        let plain = route.lean && !desc.has_masses() && !desc.lifetimes && !summed;
         let shared = Shared {
             desc,
             n,
