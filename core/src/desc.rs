@@ -245,6 +245,14 @@ impl Description {
     pub(crate) const fn has_obstacles(&self) -> bool {
         cfg!(feature = "obstacles") && self.obstacles
     }
+
+    /// `method`, [`Method::ExactFast`] by construction in a build with the
+    /// feature `exact-fast-only` ([`Layout::of`] refuses the others there):
+    /// the step reads this, so such a build holds no code for the others.
+    #[inline(always)]
+    pub(crate) const fn assignment(&self) -> Method {
+        if cfg!(feature = "exact-fast-only") { Method::ExactFast } else { self.method }
+    }
 }
 
 pub(crate) fn finite(values: &[f32]) -> Result<(), Error> {
@@ -259,4 +267,23 @@ pub(crate) fn restitution(e: f32) -> Result<(), Error> {
 pub(crate) fn mass(m: f32) -> Result<(), Error> {
     finite(&[m])?;
     if m > 0.0 { Ok(()) } else { Err(Error::MassRange) }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rules_a_build_left_out_are_refused() {
+        // Expect: a description asking for an assignment method the build
+        // left out (feature `exact-fast-only`) is refused with
+        // FeatureDisabled, and accepted by a build that has it (the
+        // default); exact-fast is accepted by every build.
+        let want = |left_out: bool| if left_out { Err(Error::FeatureDisabled) } else { Ok(()) };
+        for method in [Method::Exhaustive, Method::Greedy] {
+            let d = Description { method, ..Description::new_2d(8, 8) };
+            assert_eq!(d.validate(), want(cfg!(feature = "exact-fast-only")), "{method:?}");
+        }
+        assert_eq!(Description { method: Method::ExactFast, ..Description::new_2d(8, 8) }.validate(), Ok(()));
+    }
 }

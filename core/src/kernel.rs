@@ -680,7 +680,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
             let c = occ.trailing_zeros() as usize;
             return IDENTITY ^ u32::from(want[c]) << (4 * c);
         }
-        let method = self.shared.desc.method;
+        let method = self.shared.desc.assignment();
         if D == 2 && method == Method::ExactFast {
             let packed = pick_move(optimal_moves_2d(key), rng);
             self.counters.displaced += u64::from(packed >> 12);

@@ -7,6 +7,7 @@
 use core::mem::{align_of, size_of};
 
 use crate::cells::Cells;
+use crate::assign::Method;
 use crate::desc::{finite, mass, restitution, Boundary, Description, Quantization};
 use crate::emitter::Slot;
 use crate::obstacle::Surface;
@@ -156,6 +157,7 @@ impl Layout {
         if (d.per_particle_mass && !cfg!(feature = "mass"))
             || (d.obstacles && !cfg!(feature = "obstacles"))
             || ((d.forces.any_field() || d.drag.rate > 0.0 || d.drag.field) && !cfg!(feature = "fields"))
+            || (d.method != Method::ExactFast && cfg!(feature = "exact-fast-only"))
         {
             return Err(Error::FeatureDisabled);
         }
