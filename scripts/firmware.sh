@@ -77,10 +77,16 @@ cpu_flags() {
 # variant -> opt-level, mpca-ffi features. The smoke scene's vortex is part
 # of `fields`; the 2D-only build has nothing else (no dim3, obstacles,
 # per-particle masses, 16-bit velocities), leaves out the lean block
-# routines (`small-step`), which a world with a vortex never takes, and the
-# assignment methods the scene does not choose (`exact-fast-only`).
+# routines (`small-step`), which a world with a vortex never takes, the
+# assignment methods the scene does not choose (`exact-fast-only`) and the
+# collision rules beyond the paper's (`paper-collisions-only`).
 opt_level() { case $1 in all) echo z ;; *) echo "$1" ;; esac; }
-features() { case $1 in all) echo dim3,obstacles,fields,mass,q16 ;; *) echo fields,small-step,exact-fast-only ;; esac; }
+features() {
+    case $1 in
+        all) echo dim3,obstacles,fields,mass,q16 ;;
+        *) echo fields,small-step,exact-fast-only,paper-collisions-only ;;
+    esac
+}
 
 # The plugin's per-block counts summed per function: symbols and blocks
 # sorted together by address, each block going to the symbol before it.

@@ -253,6 +253,28 @@ impl Description {
     pub(crate) const fn assignment(&self) -> Method {
         if cfg!(feature = "exact-fast-only") { Method::ExactFast } else { self.method }
     }
+
+    /// `collisions`, [`Collisions::Paper`] by construction in a build with
+    /// the feature `paper-collisions-only` ([`Layout::of`] refuses M5.2b
+    /// there), as [`Description::assignment`].
+    #[inline(always)]
+    pub(crate) const fn collision_rule(&self) -> Collisions {
+        if cfg!(feature = "paper-collisions-only") { Collisions::Paper } else { self.collisions }
+    }
+
+    /// `contacts` (M5.7), false by construction with the feature
+    /// `paper-collisions-only`, as [`Description::has_masses`].
+    #[inline(always)]
+    pub(crate) const fn has_contacts(&self) -> bool {
+        !cfg!(feature = "paper-collisions-only") && self.contacts
+    }
+
+    /// `energy_neutral` (M1b), false by construction with the feature
+    /// `paper-collisions-only`, as [`Description::has_masses`].
+    #[inline(always)]
+    pub(crate) const fn has_energy_neutral(&self) -> bool {
+        !cfg!(feature = "paper-collisions-only") && self.energy_neutral
+    }
 }
 
 pub(crate) fn finite(values: &[f32]) -> Result<(), Error> {
@@ -275,15 +297,21 @@ mod tests {
 
     #[test]
     fn rules_a_build_left_out_are_refused() {
-        // Expect: a description asking for an assignment method the build
-        // left out (feature `exact-fast-only`) is refused with
-        // FeatureDisabled, and accepted by a build that has it (the
-        // default); exact-fast is accepted by every build.
+        // Expect: a description asking for an assignment method or a
+        // collision rule the build left out (features `exact-fast-only`,
+        // `paper-collisions-only`) is refused with FeatureDisabled, and
+        // accepted by a build that has it (the default); the paper's rules
+        // and exact-fast are accepted by every build.
         let want = |left_out: bool| if left_out { Err(Error::FeatureDisabled) } else { Ok(()) };
+        let plain = Description::new_2d(8, 8);
         for method in [Method::Exhaustive, Method::Greedy] {
-            let d = Description { method, ..Description::new_2d(8, 8) };
+            let d = Description { method, ..plain };
             assert_eq!(d.validate(), want(cfg!(feature = "exact-fast-only")), "{method:?}");
         }
-        assert_eq!(Description { method: Method::ExactFast, ..Description::new_2d(8, 8) }.validate(), Ok(()));
+        let paper_only = want(cfg!(feature = "paper-collisions-only"));
+        assert_eq!(Description { collisions: Collisions::SpeedLimited, ..plain }.validate(), paper_only, "M5.2b");
+        assert_eq!(Description { contacts: true, ..plain }.validate(), paper_only, "M5.7");
+        assert_eq!(Description { energy_neutral: true, ..plain }.validate(), paper_only, "M1b");
+        assert_eq!(plain.validate(), Ok(()));
     }
 }

@@ -474,7 +474,7 @@ fn contacts<const D: usize, const CELLS: usize>(
         let (ma, mh) = (mass[a], mass[h]);
         let s = if equal { (0.5, 0.5) } else { shares(ma, mh) };
         let (mut ya, mut yh) = collide_pair::<D>(xa, xh, s, sh.desc.restitution, r);
-        if sh.desc.energy_neutral {
+        if sh.desc.has_energy_neutral() {
             (ya, yh) = energy_neutral::<D>(ya, yh, s);
         }
         clamp_counted::<D>(&mut ya, scale, ma, counters);
@@ -606,13 +606,13 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
         }
         let s = if equal { (0.5, 0.5) } else { shares(ma, mc) };
         let e = self.shared.desc.restitution;
-        let (mut xa, mut xc) = match self.shared.desc.collisions {
+        let (mut xa, mut xc) = match self.shared.desc.collision_rule() {
             Collisions::Paper => collide_pair::<D>(va, vc, s, e, random_unit::<D>(rng)),
             // Below the limit by sqrt(D) quanta, so that rounding (less than a
             // quantum per component) cannot store a speed above 1 either.
             Collisions::SpeedLimited => collide_limited::<D>(va, vc, s, e, Q::SCALE - ROUNDING_MARGIN[D - 2], rng),
         };
-        if self.shared.desc.energy_neutral {
+        if self.shared.desc.has_energy_neutral() {
             (xa, xc) = energy_neutral::<D>(xa, xc, s);
         }
         clamp_counted::<D>(&mut xa, Q::SCALE, ma, &mut self.counters);
@@ -757,7 +757,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
             }
         });
         let targets = self.assign(occ, |c| { let x = b.velocity(c); dot(x, x) }, 0, &want, key, &mut rng);
-        if sh.desc.contacts && wanted != 0 {
+        if sh.desc.has_contacts() && wanted != 0 {
             contacts(sh, &mut b, &want, targets, &[mass; CELLS], Q::SCALE, &mut self.counters);
             b.round_apart::<Q>(&mut rng);
         }
@@ -1063,7 +1063,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
         let targets = self.assign(occ, |c| { let x = b.velocity(c); dot(x, x) }, blocked, &want, key, &mut rng);
 
         // M5.7 contacts, then M1 for what they changed.
-        if desc.contacts && wanted != 0 {
+        if desc.has_contacts() && wanted != 0 {
             contacts(sh, &mut b, &want, targets, &mass, Q::SCALE, &mut self.counters);
             b.round_apart::<Q>(&mut rng);
         }

@@ -8,7 +8,7 @@ use core::mem::{align_of, size_of};
 
 use crate::cells::Cells;
 use crate::assign::Method;
-use crate::desc::{finite, mass, restitution, Boundary, Description, Quantization};
+use crate::desc::{finite, mass, restitution, Boundary, Collisions, Description, Quantization};
 use crate::emitter::Slot;
 use crate::obstacle::Surface;
 use crate::Error;
@@ -158,6 +158,7 @@ impl Layout {
             || (d.obstacles && !cfg!(feature = "obstacles"))
             || ((d.forces.any_field() || d.drag.rate > 0.0 || d.drag.field) && !cfg!(feature = "fields"))
             || (d.method != Method::ExactFast && cfg!(feature = "exact-fast-only"))
+            || ((d.collisions != Collisions::Paper || d.contacts || d.energy_neutral) && cfg!(feature = "paper-collisions-only"))
         {
             return Err(Error::FeatureDisabled);
         }

@@ -211,7 +211,7 @@ impl World {
             moves: crate::quant::move_table_8(desc.drift),
             summed,
             plain,
-            lanes: plain && !desc.contacts,
+            lanes: plain && !desc.has_contacts(),
         };
         Setup {
             head,
