@@ -1016,8 +1016,10 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
             }
         }
 
-        // M5.1b flow drag: v <- (v + a u) / (1 + a), u the flow at the cell.
-        if let Some(flow) = &sh.drag {
+        // M5.1b flow drag: v <- (v + a u) / (1 + a), u the flow at the cell
+        // (none without the feature `fields`: `Layout::of`).
+        let drag = if cfg!(feature = "fields") { sh.drag.as_ref() } else { None };
+        if let Some(flow) = drag {
             let a = flow.rate;
             for c in cells_of(occ) {
                 let u = flow.at(sh.part.cell_coords(row, [xs[c & 1], 0, 0], c), cell(c));

@@ -174,11 +174,12 @@ impl World {
         let (head, p) = self.planes::<u8>();
         let Layout { n, .. } = head.layout;
         let Planes { occupancy, rows, words, obstacle, velocity, mass_index, life, field, potential, wind, mass_table, surface, .. } = p;
+        let forces = desc.built_forces();
         let terms = ForceTerms {
-            gravity: if desc.forces.uniform { desc.gravity } else { [0.0; 3] },
-            field: desc.forces.field.then_some(&*field),
-            potential: desc.forces.potential.then_some(&*potential),
-            vortex: desc.forces.vortex.then_some(desc.vortex),
+            gravity: if forces.uniform { desc.gravity } else { [0.0; 3] },
+            field: forces.field.then_some(&*field),
+            potential: forces.potential.then_some(&*potential),
+            vortex: forces.vortex.then_some(desc.vortex),
             n,
             periodic,
             dim,
@@ -187,7 +188,7 @@ impl World {
         let push = terms.gravity.map(|g| if dt_q == 0.0 { 0.0 } else { g * dt_q });
         // Fields, potentials, the vortex and drag are summed per particle;
         // a uniform force alone is one precomputed change (`push`).
-        let summed = cfg!(feature = "fields") && (desc.forces.any_field() || desc.drag.rate > 0.0);
+        let summed = forces.any_field() || desc.has_drag();
         let plain = route.lean && !desc.has_masses() && !desc.lifetimes && !summed;
         let shared = Shared {
             desc,
@@ -200,7 +201,7 @@ impl World {
             push: (push != [0.0; 3]).then_some(push),
             terms,
             dt_q,
-            drag: (desc.drag.rate > 0.0).then(|| Flow {
+            drag: desc.has_drag().then(|| Flow {
                 wind: desc.drag.wind.map(|w| w * scale),
                 field: desc.drag.field.then_some(&*wind),
                 vortex: desc.drag.vortex.then_some(desc.vortex),
