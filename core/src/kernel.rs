@@ -365,7 +365,10 @@ fn reflect_off<const D: usize>(sh: &Shared<'_>, x: [f32; 3], c: usize, to: Wante
             surface = Some((n, sh.desc.wall_restitution));
         }
     }
-    let (n, e) = surface.unwrap_or_else(|| match surface_at(sh.surface, to.site as u32) {
+    // A build without obstacles has no surface entry and no obstacle
+    // cell (here and below), and no code to look either up.
+    let table: &[Surface] = if cfg!(feature = "obstacles") { sh.surface } else { &[] };
+    let (n, e) = surface.unwrap_or_else(|| match surface_at(table, to.site as u32) {
         // Component by component: a copy of the array through the
         // reference is a `memmove` call at opt-level z, the only one in a
         // firmware build (1.5 KB of flash).
@@ -393,7 +396,7 @@ fn reflect_off<const D: usize>(sh: &Shared<'_>, x: [f32; 3], c: usize, to: Wante
         for (k, a) in at.iter_mut().enumerate().take(D) {
             *a += ((c >> k) & 1) as i64 - ((t >> k) & 1) as i64;
         }
-        if dot(n, back) > 0.0 && crate::obstacle::axis_move_free(sh.obstacle, sh.n, &sh.desc.boundary, at, x, D) {
+        if dot(n, back) > 0.0 && crate::obstacle::axis_move_free(if cfg!(feature = "obstacles") { sh.obstacle } else { &[] }, sh.n, &sh.desc.boundary, at, x, D) {
             return None;
         }
         back
