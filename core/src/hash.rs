@@ -11,7 +11,7 @@ impl World {
     pub fn state_hash(&self) -> u64 {
         let mut h = Fnv(0xcbf2_9ce4_8422_2325);
         let d = self.dim();
-        let l = *self.layout();
+        let l = self.layout();
         h.eat(&(self.head.desc.dim).to_le_bytes());
         for k in 0..3 {
             h.eat(&(l.n[k] as u64).to_le_bytes());
