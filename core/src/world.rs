@@ -236,7 +236,13 @@ impl World {
     }
 
     pub(crate) fn plane<T: Plain>(&self, p: crate::layout::Plane) -> &[T] {
-        view_ref(&self.mem[p.off..p.off + p.len])
+        view_ref(self.plane_bytes(p))
+    }
+
+    /// The bytes of plane `p`: the part of [`World::plane`] that does not
+    /// depend on the type, so that it exists once.
+    fn plane_bytes(&self, p: crate::layout::Plane) -> &[u8] {
+        &self.mem[p.off..p.off + p.len]
     }
 
     /// The site of `pos`, or `OutOfBounds`.
