@@ -309,8 +309,10 @@ pub(crate) fn back_normal<const D: usize>(from: usize, to: usize) -> [f32; 3] {
 /// M5.5: clamps `x` (in quanta) to the speed limit `scale`, counting the
 /// clamp and the kinetic energy it removed for mass `m`. Only the test is
 /// inlined: a clamp is rare, and its code would otherwise be copied into
-/// every stage of every block routine.
-#[inline(always)]
+/// every stage of every block routine. With `small-step` not even the
+/// test: one copy serves every stage (less flash, a call per test).
+#[cfg_attr(feature = "small-step", inline(never))]
+#[cfg_attr(not(feature = "small-step"), inline(always))]
 fn clamp_counted<const D: usize>(x: &mut [f32; 3], scale: f32, m: f32, counters: &mut Counters) {
     let s2 = dot_of::<D>(*x, *x);
     if s2 <= scale * scale {
@@ -503,8 +505,11 @@ struct Block<const D: usize, const CELLS: usize> {
 }
 
 impl<const D: usize, const CELLS: usize> Block<D, CELLS> {
-    /// The velocity of the particle in cell `c`, in quanta.
-    #[inline(always)]
+    /// The velocity of the particle in cell `c`, in quanta. Out of line
+    /// with `small-step`: one copy for every stage (less flash, a call a
+    /// read).
+    #[cfg_attr(feature = "small-step", inline(never))]
+    #[cfg_attr(not(feature = "small-step"), inline(always))]
     fn velocity(&self, c: usize) -> [f32; 3] {
         if self.pending >> c & 1 != 0 {
             return self.x[c];
