@@ -168,7 +168,8 @@ impl World {
     #[inline(never)]
     fn setup(&mut self, route: Route, scale: f32) -> Setup<'_> {
         let part = Partition::new(self.layout(), &self.head.desc.boundary, self.dim(), self.head.step);
-        let periodic = self.periodic();
+        // Read by the potential's gradient alone, which only `fields` has.
+        let periodic = if cfg!(feature = "fields") { self.periodic() } else { [false; 3] };
         let dim = self.dim();
         let desc = self.head.desc;
         let (head, p) = self.planes::<u8>();
@@ -196,7 +197,8 @@ impl World {
             part,
             key: StepKey::blocks(desc.seed, head.step),
             obstacle,
-            surface: &surface[..head.surfaces as usize],
+            // A build without obstacles has no surface entry to slice.
+            surface: if cfg!(feature = "obstacles") { &surface[..head.surfaces as usize] } else { &[] },
             mass_table,
             push: (push != [0.0; 3]).then_some(push),
             terms,
