@@ -528,8 +528,10 @@ impl<const D: usize, const CELLS: usize> Block<D, CELLS> {
     }
 
     /// M1: rounds every pending velocity back to storage, one 64-bit output
-    /// of the stream each, in cell order.
-    #[inline(always)]
+    /// of the stream each, in cell order. Out of line with `small-step`:
+    /// one copy for every stage.
+    #[cfg_attr(feature = "small-step", inline(never))]
+    #[cfg_attr(not(feature = "small-step"), inline(always))]
     fn round<Q: Quant>(&mut self, rng: &mut Stream) {
         for c in cells_of(self.pending) {
             self.v[c] = Q::round::<D>(self.x[c], rng);
