@@ -263,8 +263,9 @@ impl World {
         test_bit(self.plane(self.layout().occupancy), s.bit)
     }
 
+    /// Whether cell `s` is an obstacle: never in a build without obstacles.
     pub(crate) fn is_obstacle(&self, s: Site) -> bool {
-        test_bit(self.plane(self.layout().obstacle), s.bit)
+        cfg!(feature = "obstacles") && test_bit(self.plane(self.layout().obstacle), s.bit)
     }
 }
 
