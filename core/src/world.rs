@@ -200,8 +200,9 @@ impl World {
         &self.head.layout
     }
 
+    /// 2 or 3; 2 in a build without `dim3`, whose worlds are all 2D.
     pub(crate) fn dim(&self) -> usize {
-        self.head.desc.dim as usize
+        if cfg!(feature = "dim3") { self.head.desc.dim as usize } else { 2 }
     }
 
     /// The header and every plane, borrowed apart.
