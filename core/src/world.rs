@@ -135,7 +135,7 @@ impl World {
             base.cast::<Header>().write(head);
             let world = core::ptr::slice_from_raw_parts_mut(base, layout.total) as *mut World;
             let world = &mut *world;
-            if desc.per_particle_mass {
+            if desc.has_masses() {
                 // Class 0 is the description's mass, for particles added without one.
                 world.planes::<i8>().1.mass_table[0] = desc.mass;
                 world.head.masses = 1;
