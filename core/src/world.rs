@@ -33,13 +33,17 @@ impl Counters {
     /// Adds what a sweep of blocks counts (a task's share of a step). The
     /// running totals saturate: an image (M12) may carry any count.
     pub fn add_step(&mut self, c: &Counters) {
-        self.exited = self.exited.saturating_add(c.exited);
-        self.expired = self.expired.saturating_add(c.expired);
-        self.collisions = self.collisions.saturating_add(c.collisions);
-        self.clamps = self.clamps.saturating_add(c.clamps);
-        self.clamp_energy = self.clamp_energy.saturating_add(c.clamp_energy);
-        self.displaced = self.displaced.saturating_add(c.displaced);
-        self.processed = self.processed.saturating_add(c.processed);
+        for (total, add) in [
+            (&mut self.exited, c.exited),
+            (&mut self.expired, c.expired),
+            (&mut self.collisions, c.collisions),
+            (&mut self.clamps, c.clamps),
+            (&mut self.clamp_energy, c.clamp_energy),
+            (&mut self.displaced, c.displaced),
+            (&mut self.processed, c.processed),
+        ] {
+            *total = total.saturating_add(add);
+        }
     }
 }
 
