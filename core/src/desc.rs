@@ -230,6 +230,69 @@ impl Description {
     pub fn validate(&self) -> Result<(), Error> {
         Layout::of(self).map(|_| ())
     }
+
+    /// `per_particle_mass`, false by construction in a build without the
+    /// feature `mass` ([`Layout::of`] refuses it there): the step and the
+    /// edits test this, so such a build holds no code for masses.
+    #[inline(always)]
+    pub(crate) const fn has_masses(&self) -> bool {
+        cfg!(feature = "mass") && self.per_particle_mass
+    }
+
+    /// `obstacles`, false by construction in a build without the feature
+    /// `obstacles`, as [`Description::has_masses`].
+    #[inline(always)]
+    pub(crate) const fn has_obstacles(&self) -> bool {
+        cfg!(feature = "obstacles") && self.obstacles
+    }
+
+    /// `forces` with the terms this build leaves out false, as they are by
+    /// construction ([`Layout::of`] refuses them): the vortex needs the
+    /// feature `vortex`, the force field and the potential `fields`. The
+    /// step reads this, so a build without them holds no code for them.
+    #[inline(always)]
+    pub(crate) const fn built_forces(&self) -> Forces {
+        let fields = cfg!(feature = "fields");
+        let f = self.forces;
+        Forces { uniform: f.uniform, field: fields && f.field, potential: fields && f.potential, vortex: cfg!(feature = "vortex") && f.vortex }
+    }
+
+    /// Whether flow drag is on (M5.1b: a rate above 0), false by
+    /// construction without the feature `fields`.
+    #[inline(always)]
+    pub(crate) fn has_drag(&self) -> bool {
+        cfg!(feature = "fields") && self.drag.rate > 0.0
+    }
+
+    /// `method`, [`Method::ExactFast`] by construction in a build with the
+    /// feature `exact-fast-only` ([`Layout::of`] refuses the others there):
+    /// the step reads this, so such a build holds no code for the others.
+    #[inline(always)]
+    pub(crate) const fn assignment(&self) -> Method {
+        if cfg!(feature = "exact-fast-only") { Method::ExactFast } else { self.method }
+    }
+
+    /// `collisions`, [`Collisions::Paper`] by construction in a build with
+    /// the feature `paper-collisions-only` ([`Layout::of`] refuses M5.2b
+    /// there), as [`Description::assignment`].
+    #[inline(always)]
+    pub(crate) const fn collision_rule(&self) -> Collisions {
+        if cfg!(feature = "paper-collisions-only") { Collisions::Paper } else { self.collisions }
+    }
+
+    /// `contacts` (M5.7), false by construction with the feature
+    /// `paper-collisions-only`, as [`Description::has_masses`].
+    #[inline(always)]
+    pub(crate) const fn has_contacts(&self) -> bool {
+        !cfg!(feature = "paper-collisions-only") && self.contacts
+    }
+
+    /// `energy_neutral` (M1b), false by construction with the feature
+    /// `paper-collisions-only`, as [`Description::has_masses`].
+    #[inline(always)]
+    pub(crate) const fn has_energy_neutral(&self) -> bool {
+        !cfg!(feature = "paper-collisions-only") && self.energy_neutral
+    }
 }
 
 pub(crate) fn finite(values: &[f32]) -> Result<(), Error> {
@@ -244,4 +307,36 @@ pub(crate) fn restitution(e: f32) -> Result<(), Error> {
 pub(crate) fn mass(m: f32) -> Result<(), Error> {
     finite(&[m])?;
     if m > 0.0 { Ok(()) } else { Err(Error::MassRange) }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rules_a_build_left_out_are_refused() {
+        // Expect: a description asking for an assignment method, a
+        // collision rule or a force the build left out (features
+        // `exact-fast-only`, `paper-collisions-only`; without `vortex`,
+        // `fields`) is refused with FeatureDisabled, and accepted by a
+        // build that has it (the default); the paper's rules and
+        // exact-fast are accepted by every build.
+        let want = |left_out: bool| if left_out { Err(Error::FeatureDisabled) } else { Ok(()) };
+        let plain = Description::new_2d(8, 8);
+        for method in [Method::Exhaustive, Method::Greedy] {
+            let d = Description { method, ..plain };
+            assert_eq!(d.validate(), want(cfg!(feature = "exact-fast-only")), "{method:?}");
+        }
+        let paper_only = want(cfg!(feature = "paper-collisions-only"));
+        assert_eq!(Description { collisions: Collisions::SpeedLimited, ..plain }.validate(), paper_only, "M5.2b");
+        assert_eq!(Description { contacts: true, ..plain }.validate(), paper_only, "M5.7");
+        assert_eq!(Description { energy_neutral: true, ..plain }.validate(), paper_only, "M1b");
+        // The vortex needs `vortex` (which `fields` implies), the other
+        // summed forces and drag need `fields`.
+        let vortex = Forces { vortex: true, ..plain.forces };
+        assert_eq!(Description { forces: vortex, ..plain }.validate(), want(!cfg!(feature = "vortex")), "vortex");
+        let field = Forces { field: true, ..plain.forces };
+        assert_eq!(Description { forces: field, ..plain }.validate(), want(!cfg!(feature = "fields")), "force field");
+        assert_eq!(plain.validate(), Ok(()));
+    }
 }

@@ -56,7 +56,7 @@ impl World {
     /// error.
     pub(crate) fn mass_index_of(&mut self, m: f32) -> Result<u8, Error> {
         crate::desc::mass(m)?;
-        if !self.head.desc.per_particle_mass {
+        if !self.head.desc.has_masses() {
             return if m == self.head.desc.mass { Ok(0) } else { Err(Error::NotEnabled) };
         }
         let used = self.head.masses as usize;
@@ -119,7 +119,7 @@ impl World {
     fn place(&mut self, s: Site, v: [f32; 3], mass_index: u8, life: u16, stream: Option<&mut crate::rng::Stream>) {
         let d = self.dim();
         let summary_words = self.layout().summary_words;
-        let per_mass = self.head.desc.per_particle_mass;
+        let per_mass = self.head.desc.has_masses();
         let lifetimes = self.head.desc.lifetimes;
         with_quant!(self.head.desc.quantization, Q => {
             let (_, p) = self.planes::<Q>();

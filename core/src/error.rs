@@ -45,7 +45,8 @@ pub enum Error {
     /// 16-bit velocities need the `q16` feature, which this build left out.
     Q16Disabled = 112,
     /// The description asks for a part (obstacles, fields, per-particle
-    /// masses) that this build left out.
+    /// masses) or a rule (an assignment method other than exact-fast, a
+    /// collision rule beyond the paper's) that this build left out.
     FeatureDisabled = 113,
     /// The world was built without the part this call uses (M9).
     NotEnabled = 114,

@@ -25,15 +25,19 @@ impl ForceTerms<'_> {
     #[inline]
     pub fn accel(&self, pos: [usize; 3], cell: usize, m: f32) -> [f32; 3] {
         let mut f = [0.0f32; 3];
-        if let Some(field) = self.field {
-            for k in 0..self.dim {
-                f[k] += field[cell * self.dim + k];
+        // Without the feature `fields` a world has neither term
+        // (`Layout::of`), and the build no code for them.
+        if cfg!(feature = "fields") {
+            if let Some(field) = self.field {
+                for k in 0..self.dim {
+                    f[k] += field[cell * self.dim + k];
+                }
             }
-        }
-        if let Some(u) = self.potential {
-            let g = self.grad(u, pos, cell);
-            for k in 0..self.dim {
-                f[k] -= g[k]; // eq. 6: F = -grad U
+            if let Some(u) = self.potential {
+                let g = self.grad(u, pos, cell);
+                for k in 0..self.dim {
+                    f[k] -= g[k]; // eq. 6: F = -grad U
+                }
             }
         }
         if let Some(v) = self.vortex {

@@ -11,13 +11,12 @@ impl World {
     pub fn state_hash(&self) -> u64 {
         let mut h = Fnv(0xcbf2_9ce4_8422_2325);
         let d = self.dim();
-        let l = *self.layout();
+        let l = self.layout();
         h.eat(&(self.head.desc.dim).to_le_bytes());
         for k in 0..3 {
             h.eat(&(l.n[k] as u64).to_le_bytes());
         }
-        for p in self.particles() {
-            let cell = l.site(p.pos[0] as usize, p.pos[1] as usize, p.pos[2] as usize).cell;
+        for (_, cell) in self.occupied_cells() {
             h.eat(&(cell as u64).to_le_bytes());
             with_quant!(self.head.desc.quantization, Q => {
                 let plane: &[Q] = self.plane(l.velocity);
@@ -25,8 +24,8 @@ impl World {
                     h.eat(&plane[cell * d + k].to_int().to_le_bytes());
                 }
             });
-            h.eat(&p.mass.to_bits().to_le_bytes());
-            h.eat(&p.life.to_le_bytes());
+            h.eat(&self.mass_at(cell).to_bits().to_le_bytes());
+            h.eat(&self.life_at(cell).to_le_bytes());
         }
         h.0
     }

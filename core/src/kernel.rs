@@ -309,8 +309,10 @@ pub(crate) fn back_normal<const D: usize>(from: usize, to: usize) -> [f32; 3] {
 /// M5.5: clamps `x` (in quanta) to the speed limit `scale`, counting the
 /// clamp and the kinetic energy it removed for mass `m`. Only the test is
 /// inlined: a clamp is rare, and its code would otherwise be copied into
-/// every stage of every block routine.
-#[inline(always)]
+/// every stage of every block routine. With `small-step` not even the
+/// test: one copy serves every stage (less flash, a call per test).
+#[cfg_attr(feature = "small-step", inline(never))]
+#[cfg_attr(not(feature = "small-step"), inline(always))]
 fn clamp_counted<const D: usize>(x: &mut [f32; 3], scale: f32, m: f32, counters: &mut Counters) {
     let s2 = dot_of::<D>(*x, *x);
     if s2 <= scale * scale {
@@ -365,7 +367,10 @@ fn reflect_off<const D: usize>(sh: &Shared<'_>, x: [f32; 3], c: usize, to: Wante
             surface = Some((n, sh.desc.wall_restitution));
         }
     }
-    let (n, e) = surface.unwrap_or_else(|| match surface_at(sh.surface, to.site as u32) {
+    // A build without obstacles has no surface entry and no obstacle
+    // cell (here and below), and no code to look either up.
+    let table: &[Surface] = if cfg!(feature = "obstacles") { sh.surface } else { &[] };
+    let (n, e) = surface.unwrap_or_else(|| match surface_at(table, to.site as u32) {
         // Component by component: a copy of the array through the
         // reference is a `memmove` call at opt-level z, the only one in a
         // firmware build (1.5 KB of flash).
@@ -376,7 +381,11 @@ fn reflect_off<const D: usize>(sh: &Shared<'_>, x: [f32; 3], c: usize, to: Wante
         None => (back_normal::<D>(c, t), sh.desc.wall_restitution),
     });
     let back = back_normal::<D>(c, t);
-    let n = if dot(x, n) < 0.0 {
+    // Without obstacles only cells beyond a wall face are blocked, and a
+    // particle asks for one only moving towards it (M5.3: every axis it
+    // crosses points out of the domain), so N.v < 0: a build without
+    // obstacles leaves out the case below (the tests check the claim).
+    let n = if !cfg!(feature = "obstacles") || dot(x, n) < 0.0 {
         n
     } else {
         // The particle already leaves the surface (N.v >= 0), yet asks
@@ -393,7 +402,7 @@ fn reflect_off<const D: usize>(sh: &Shared<'_>, x: [f32; 3], c: usize, to: Wante
         for (k, a) in at.iter_mut().enumerate().take(D) {
             *a += ((c >> k) & 1) as i64 - ((t >> k) & 1) as i64;
         }
-        if dot(n, back) > 0.0 && crate::obstacle::axis_move_free(sh.obstacle, sh.n, &sh.desc.boundary, at, x, D) {
+        if dot(n, back) > 0.0 && crate::obstacle::axis_move_free(if cfg!(feature = "obstacles") { sh.obstacle } else { &[] }, sh.n, &sh.desc.boundary, at, x, D) {
             return None;
         }
         back
@@ -458,7 +467,7 @@ fn contacts<const D: usize, const CELLS: usize>(
     scale: f32,
     counters: &mut Counters,
 ) {
-    let equal = !sh.desc.per_particle_mass;
+    let equal = !sh.desc.has_masses();
     for a in cells_of(b.occ) {
         let wanted = a ^ usize::from(want[a]);
         if want[a] == 0 || (targets >> (4 * a) & 7) as usize == wanted {
@@ -474,7 +483,7 @@ fn contacts<const D: usize, const CELLS: usize>(
         let (ma, mh) = (mass[a], mass[h]);
         let s = if equal { (0.5, 0.5) } else { shares(ma, mh) };
         let (mut ya, mut yh) = collide_pair::<D>(xa, xh, s, sh.desc.restitution, r);
-        if sh.desc.energy_neutral {
+        if sh.desc.has_energy_neutral() {
             (ya, yh) = energy_neutral::<D>(ya, yh, s);
         }
         clamp_counted::<D>(&mut ya, scale, ma, counters);
@@ -500,8 +509,11 @@ struct Block<const D: usize, const CELLS: usize> {
 }
 
 impl<const D: usize, const CELLS: usize> Block<D, CELLS> {
-    /// The velocity of the particle in cell `c`, in quanta.
-    #[inline(always)]
+    /// The velocity of the particle in cell `c`, in quanta. Out of line
+    /// with `small-step`: one copy for every stage (less flash, a call a
+    /// read).
+    #[cfg_attr(feature = "small-step", inline(never))]
+    #[cfg_attr(not(feature = "small-step"), inline(always))]
     fn velocity(&self, c: usize) -> [f32; 3] {
         if self.pending >> c & 1 != 0 {
             return self.x[c];
@@ -520,8 +532,10 @@ impl<const D: usize, const CELLS: usize> Block<D, CELLS> {
     }
 
     /// M1: rounds every pending velocity back to storage, one 64-bit output
-    /// of the stream each, in cell order.
-    #[inline(always)]
+    /// of the stream each, in cell order. Out of line with `small-step`:
+    /// one copy for every stage.
+    #[cfg_attr(feature = "small-step", inline(never))]
+    #[cfg_attr(not(feature = "small-step"), inline(always))]
     fn round<Q: Quant>(&mut self, rng: &mut Stream) {
         for c in cells_of(self.pending) {
             self.v[c] = Q::round::<D>(self.x[c], rng);
@@ -606,13 +620,13 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
         }
         let s = if equal { (0.5, 0.5) } else { shares(ma, mc) };
         let e = self.shared.desc.restitution;
-        let (mut xa, mut xc) = match self.shared.desc.collisions {
+        let (mut xa, mut xc) = match self.shared.desc.collision_rule() {
             Collisions::Paper => collide_pair::<D>(va, vc, s, e, random_unit::<D>(rng)),
             // Below the limit by sqrt(D) quanta, so that rounding (less than a
             // quantum per component) cannot store a speed above 1 either.
             Collisions::SpeedLimited => collide_limited::<D>(va, vc, s, e, Q::SCALE - ROUNDING_MARGIN[D - 2], rng),
         };
-        if self.shared.desc.energy_neutral {
+        if self.shared.desc.has_energy_neutral() {
             (xa, xc) = energy_neutral::<D>(xa, xc, s);
         }
         clamp_counted::<D>(&mut xa, Q::SCALE, ma, &mut self.counters);
@@ -680,7 +694,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
             let c = occ.trailing_zeros() as usize;
             return IDENTITY ^ u32::from(want[c]) << (4 * c);
         }
-        let method = self.shared.desc.method;
+        let method = self.shared.desc.assignment();
         if D == 2 && method == Method::ExactFast {
             let packed = pick_move(optimal_moves_2d(key), rng);
             self.counters.displaced += u64::from(packed >> 12);
@@ -757,7 +771,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
             }
         });
         let targets = self.assign(occ, |c| { let x = b.velocity(c); dot(x, x) }, 0, &want, key, &mut rng);
-        if sh.desc.contacts && wanted != 0 {
+        if sh.desc.has_contacts() && wanted != 0 {
             contacts(sh, &mut b, &want, targets, &[mass; CELLS], Q::SCALE, &mut self.counters);
             b.round_apart::<Q>(&mut rng);
         }
@@ -980,14 +994,14 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
                 _ => open |= 1 << c,
             }
         }
-        let blocked = wall | if desc.obstacles { read_block::<CELLS>(sh.obstacle, row, xs) & !outside & Self::ALL } else { 0 };
+        let blocked = wall | if desc.has_obstacles() { read_block::<CELLS>(sh.obstacle, row, xs) & !outside & Self::ALL } else { 0 };
 
         let mut b = self.load(row, xs, occ);
         let mut mass = [desc.mass; CELLS];
         let mut mass_index = [0u8; CELLS];
         let mut life = [0u16; CELLS];
         for c in cells_of(occ) {
-            if desc.per_particle_mass {
+            if desc.has_masses() {
                 mass_index[c] = self.planes.mass_index.get(cell(c));
                 mass[c] = sh.mass_table[usize::from(mass_index[c])];
             }
@@ -1016,8 +1030,10 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
             }
         }
 
-        // M5.1b flow drag: v <- (v + a u) / (1 + a), u the flow at the cell.
-        if let Some(flow) = &sh.drag {
+        // M5.1b flow drag: v <- (v + a u) / (1 + a), u the flow at the cell
+        // (none without the feature `fields`: `Layout::of`).
+        let drag = if cfg!(feature = "fields") { sh.drag.as_ref() } else { None };
+        if let Some(flow) = drag {
             let a = flow.rate;
             for c in cells_of(occ) {
                 let u = flow.at(sh.part.cell_coords(row, [xs[c & 1], 0, 0], c), cell(c));
@@ -1032,7 +1048,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
 
         // M5.2 collision, then M1 for what the force, the drag and the
         // collision changed.
-        self.collide(&mut b, &mut rng, |c| mass[c], !desc.per_particle_mass);
+        self.collide(&mut b, &mut rng, |c| mass[c], !desc.has_masses());
         b.round::<Q>(&mut rng);
 
         // M5.3 desired move, M5.4 obstacle reflection: `want[c]` holds the
@@ -1063,7 +1079,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
         let targets = self.assign(occ, |c| { let x = b.velocity(c); dot(x, x) }, blocked, &want, key, &mut rng);
 
         // M5.7 contacts, then M1 for what they changed.
-        if desc.contacts && wanted != 0 {
+        if desc.has_contacts() && wanted != 0 {
             contacts(sh, &mut b, &want, targets, &mass, Q::SCALE, &mut self.counters);
             b.round_apart::<Q>(&mut rng);
         }
@@ -1087,7 +1103,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
                 if t != c || b.dirty >> c & 1 != 0 {
                     self.store(&b, c, to);
                 }
-                if desc.per_particle_mass && t != c {
+                if desc.has_masses() && t != c {
                     self.planes.mass_index.set(to, mass_index[c]);
                 }
                 if desc.lifetimes {
@@ -1120,7 +1136,7 @@ impl<'a, Q: Quant, const D: usize, const CELLS: usize> BlockSink<'a> for Kernel<
             // test on x (n >= 1: Layout::of refuses an empty axis).
             let x = x0 as usize;
             let pairwise = sh.lanes && row.outside == 0 && x < sh.n[0] - 1;
-            if pairwise && (!sh.desc.obstacles || read_block::<CELLS>(sh.obstacle, row, [x, x + 1]) == 0) {
+            if pairwise && (!sh.desc.has_obstacles() || read_block::<CELLS>(sh.obstacle, row, [x, x + 1]) == 0) {
                 return self.lean_2d(row, x, row.index + bx as u64, occ);
             }
             return self.general(row, x0, bx, occ);
@@ -1132,7 +1148,7 @@ impl<'a, Q: Quant, const D: usize, const CELLS: usize> BlockSink<'a> for Kernel<
             // cells as neighbours.
             if x0 + 1 < sh.n[0] {
                 // A world with obstacles: only blocks without one are lean.
-                if !sh.desc.obstacles || read_block::<CELLS>(sh.obstacle, row, [x0, x0 + 1]) == 0 {
+                if !sh.desc.has_obstacles() || read_block::<CELLS>(sh.obstacle, row, [x0, x0 + 1]) == 0 {
                     return self.lean(row, [x0, x0 + 1], row.index + bx as u64, occ);
                 }
             }
@@ -1167,6 +1183,58 @@ mod tests {
                     }
                 }
                 assert_eq!(inward_lanes(lanes, occ), want, "{lanes:#018x} {occ:#06b}");
+            }
+        }
+    }
+
+    #[test]
+    fn a_wall_is_only_asked_for_against_its_normal() {
+        // Expect: where only walls block (no obstacles), a particle whose
+        // wish (M5.3: an axis of the block it crosses towards the block's
+        // other half, its velocity component pointing that way) lands
+        // beyond a wall moves against the wall's normal, N.v < 0: for
+        // every block across the faces of a 2D and a 3D box, every mix of
+        // wall and open faces, every cell inside the box, every wish and
+        // every sign of the components it does not cross. reflect_off
+        // leaves out N.v >= 0 without obstacles on this.
+        use crate::desc::Boundary;
+        for dim in [2usize, 3] {
+            let n = [4usize, 4, if dim == 3 { 4 } else { 1 }];
+            let cells = 1usize << dim;
+            for faces in 0..1u32 << (2 * dim) {
+                let mut boundary = [[Boundary::Wall; 2]; 3];
+                for k in 0..dim {
+                    for side in 0..2 {
+                        if faces >> (2 * k + side) & 1 != 0 {
+                            boundary[k][side] = Boundary::Open;
+                        }
+                    }
+                }
+                // The block's lowest corner: -1 (across the low face) or
+                // n - 1 (across the high one) on each axis.
+                for corner in 0..cells {
+                    let origin: [i64; 3] = core::array::from_fn(|k| if k >= dim { 0 } else if corner >> k & 1 == 0 { -1 } else { n[k] as i64 - 1 });
+                    let at = |c: usize| -> [i64; 3] { core::array::from_fn(|k| if k >= dim { 0 } else { origin[k] + (c >> k & 1) as i64 }) };
+                    for c in 0..cells {
+                        if !matches!(resolve(n, &boundary, at(c)), Beyond::Inside(_)) {
+                            continue;
+                        }
+                        for wish in 1..cells {
+                            let Beyond::Wall(normal) = resolve(n, &boundary, at(c ^ wish)) else { continue };
+                            for signs in 0..3usize.pow(dim as u32) {
+                                let mut v = [0.0f32; 3];
+                                for k in 0..dim {
+                                    v[k] = if wish >> k & 1 != 0 {
+                                        if c >> k & 1 == 0 { 1.0 } else { -1.0 }
+                                    } else {
+                                        (signs / 3usize.pow(k as u32) % 3) as f32 - 1.0
+                                    };
+                                }
+                                assert!(dot(v, normal) < 0.0, "{dim}D faces {faces:#b} corner {corner} cell {c} wish {wish:#b} v {v:?} N {normal:?}");
+                            }
+                        }
+                    }
+                }
             }
         }
     }

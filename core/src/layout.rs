@@ -7,7 +7,8 @@
 use core::mem::{align_of, size_of};
 
 use crate::cells::Cells;
-use crate::desc::{finite, mass, restitution, Boundary, Description, Quantization};
+use crate::assign::Method;
+use crate::desc::{finite, mass, restitution, Boundary, Collisions, Description, Quantization};
 use crate::emitter::Slot;
 use crate::obstacle::Surface;
 use crate::Error;
@@ -155,7 +156,10 @@ impl Layout {
         }
         if (d.per_particle_mass && !cfg!(feature = "mass"))
             || (d.obstacles && !cfg!(feature = "obstacles"))
-            || ((d.forces.any_field() || d.drag.rate > 0.0 || d.drag.field) && !cfg!(feature = "fields"))
+            || ((d.forces.field || d.forces.potential || d.drag.rate > 0.0 || d.drag.field) && !cfg!(feature = "fields"))
+            || (d.forces.vortex && !cfg!(feature = "vortex"))
+            || (d.method != Method::ExactFast && cfg!(feature = "exact-fast-only"))
+            || ((d.collisions != Collisions::Paper || d.contacts || d.energy_neutral) && cfg!(feature = "paper-collisions-only"))
         {
             return Err(Error::FeatureDisabled);
         }

@@ -1,6 +1,7 @@
 //! What a world can be asked: a cell, every particle, densities for a
 //! texture, statistics (M10), and the particles and motion inside a box.
 
+use crate::layout::Layout;
 use crate::quant::{with_quant, Quant};
 use crate::world::{World, ENERGY_SCALE};
 use crate::Error;
@@ -109,7 +110,7 @@ impl World {
     }
 
     pub(crate) fn mass_at(&self, cell: usize) -> f32 {
-        if self.head.desc.per_particle_mass {
+        if self.head.desc.has_masses() {
             let idx: &[u8] = self.plane(self.layout().mass_index);
             let table: &[f32] = self.plane(self.layout().mass_table);
             table[usize::from(idx[cell])]
@@ -118,9 +119,13 @@ impl World {
         }
     }
 
+    /// The remaining lifetime of the particle in `cell`, 0 for none.
+    pub(crate) fn life_at(&self, cell: usize) -> u16 {
+        if self.head.desc.lifetimes { self.plane::<u16>(self.layout().life)[cell] } else { 0 }
+    }
+
     pub(crate) fn particle_at(&self, pos: [u32; 3], cell: usize) -> Particle {
-        let life = if self.head.desc.lifetimes { self.plane::<u16>(self.layout().life)[cell] } else { 0 };
-        Particle { pos, velocity: self.velocity_at(cell), mass: self.mass_at(cell), life }
+        Particle { pos, velocity: self.velocity_at(cell), mass: self.mass_at(cell), life: self.life_at(cell) }
     }
 
     /// What the cell at `pos` holds.
@@ -137,7 +142,12 @@ impl World {
 
     /// Every particle, in cell order (x fastest).
     pub fn particles(&self) -> Particles<'_> {
-        Particles { world: self, word: 0, bits: 0, words: self.plane::<u64>(self.layout().occupancy) }
+        Particles { world: self, cells: self.occupied_cells() }
+    }
+
+    /// The cells holding a particle, in cell order (x fastest).
+    pub(crate) fn occupied_cells(&self) -> Occupied<'_> {
+        Occupied { layout: self.layout(), word: 0, bits: 0, words: self.plane::<u64>(self.layout().occupancy) }
     }
 
     /// Fills `out` with the share of cells holding a particle in each of
@@ -298,15 +308,31 @@ fn count_bits(plane: &[u64], bit: usize, len: usize) -> usize {
 /// Iterator over a world's particles, from [`World::particles`].
 pub struct Particles<'a> {
     world: &'a World,
-    words: &'a [u64],
-    word: usize,
-    bits: u64,
+    cells: Occupied<'a>,
 }
 
 impl Iterator for Particles<'_> {
     type Item = Particle;
 
     fn next(&mut self) -> Option<Particle> {
+        let (pos, cell) = self.cells.next()?;
+        Some(self.world.particle_at(pos, cell))
+    }
+}
+
+/// Iterator over the cells holding a particle, from
+/// [`World::occupied_cells`]: each cell's coordinates and dense index.
+pub(crate) struct Occupied<'a> {
+    layout: &'a Layout,
+    words: &'a [u64],
+    word: usize,
+    bits: u64,
+}
+
+impl Iterator for Occupied<'_> {
+    type Item = ([u32; 3], usize);
+
+    fn next(&mut self) -> Option<([u32; 3], usize)> {
         while self.bits == 0 {
             let w = *self.words.get(self.word)?;
             self.bits = w;
@@ -314,12 +340,11 @@ impl Iterator for Particles<'_> {
         }
         let b = self.bits.trailing_zeros() as usize;
         self.bits &= self.bits - 1;
-        let l = self.world.layout();
+        let l = self.layout;
         let w = self.word - 1;
         let row = w / l.row_words;
         let x = (w % l.row_words) * 64 + b;
         let (y, z) = (row % l.n[1], row / l.n[1]);
-        let pos = [x as u32, y as u32, z as u32];
-        Some(self.world.particle_at(pos, l.site(x, y, z).cell))
+        Some(([x as u32, y as u32, z as u32], l.site(x, y, z).cell))
     }
 }

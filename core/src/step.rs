@@ -168,17 +168,19 @@ impl World {
     #[inline(never)]
     fn setup(&mut self, route: Route, scale: f32) -> Setup<'_> {
         let part = Partition::new(self.layout(), &self.head.desc.boundary, self.dim(), self.head.step);
-        let periodic = self.periodic();
+        // Read by the potential's gradient alone, which only `fields` has.
+        let periodic = if cfg!(feature = "fields") { self.periodic() } else { [false; 3] };
         let dim = self.dim();
         let desc = self.head.desc;
         let (head, p) = self.planes::<u8>();
         let Layout { n, .. } = head.layout;
         let Planes { occupancy, rows, words, obstacle, velocity, mass_index, life, field, potential, wind, mass_table, surface, .. } = p;
+        let forces = desc.built_forces();
         let terms = ForceTerms {
-            gravity: if desc.forces.uniform { desc.gravity } else { [0.0; 3] },
-            field: desc.forces.field.then_some(&*field),
-            potential: desc.forces.potential.then_some(&*potential),
-            vortex: desc.forces.vortex.then_some(desc.vortex),
+            gravity: if forces.uniform { desc.gravity } else { [0.0; 3] },
+            field: forces.field.then_some(&*field),
+            potential: forces.potential.then_some(&*potential),
+            vortex: forces.vortex.then_some(desc.vortex),
             n,
             periodic,
             dim,
@@ -187,20 +189,21 @@ impl World {
         let push = terms.gravity.map(|g| if dt_q == 0.0 { 0.0 } else { g * dt_q });
         // Fields, potentials, the vortex and drag are summed per particle;
         // a uniform force alone is one precomputed change (`push`).
-        let summed = cfg!(feature = "fields") && (desc.forces.any_field() || desc.drag.rate > 0.0);
-        let plain = route.lean && !desc.per_particle_mass && !desc.lifetimes && !summed;
+        let summed = forces.any_field() || desc.has_drag();
+        let plain = route.lean && !desc.has_masses() && !desc.lifetimes && !summed;
         let shared = Shared {
             desc,
             n,
             part,
             key: StepKey::blocks(desc.seed, head.step),
             obstacle,
-            surface: &surface[..head.surfaces as usize],
+            // A build without obstacles has no surface entry to slice.
+            surface: if cfg!(feature = "obstacles") { &surface[..head.surfaces as usize] } else { &[] },
             mass_table,
             push: (push != [0.0; 3]).then_some(push),
             terms,
             dt_q,
-            drag: (desc.drag.rate > 0.0).then(|| Flow {
+            drag: desc.has_drag().then(|| Flow {
                 wind: desc.drag.wind.map(|w| w * scale),
                 field: desc.drag.field.then_some(&*wind),
                 vortex: desc.drag.vortex.then_some(desc.vortex),
@@ -211,7 +214,7 @@ impl World {
             moves: crate::quant::move_table_8(desc.drift),
             summed,
             plain,
-            lanes: plain && !desc.contacts,
+            lanes: plain && !desc.has_contacts(),
         };
         Setup {
             head,

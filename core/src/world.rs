@@ -33,13 +33,17 @@ impl Counters {
     /// Adds what a sweep of blocks counts (a task's share of a step). The
     /// running totals saturate: an image (M12) may carry any count.
     pub fn add_step(&mut self, c: &Counters) {
-        self.exited = self.exited.saturating_add(c.exited);
-        self.expired = self.expired.saturating_add(c.expired);
-        self.collisions = self.collisions.saturating_add(c.collisions);
-        self.clamps = self.clamps.saturating_add(c.clamps);
-        self.clamp_energy = self.clamp_energy.saturating_add(c.clamp_energy);
-        self.displaced = self.displaced.saturating_add(c.displaced);
-        self.processed = self.processed.saturating_add(c.processed);
+        for (total, add) in [
+            (&mut self.exited, c.exited),
+            (&mut self.expired, c.expired),
+            (&mut self.collisions, c.collisions),
+            (&mut self.clamps, c.clamps),
+            (&mut self.clamp_energy, c.clamp_energy),
+            (&mut self.displaced, c.displaced),
+            (&mut self.processed, c.processed),
+        ] {
+            *total = total.saturating_add(add);
+        }
     }
 }
 
@@ -106,7 +110,11 @@ impl World {
             return Err(Error::BufferTooSmall);
         }
         let region = &mut memory[pad..need];
-        region.fill(0);
+        // Cleared as 64-bit words, which it is made of: `pad` aligns its
+        // start, and the header and every plane are multiples of 8 bytes
+        // (`Layout`), so the aligned clear covers it all.
+        debug_assert_eq!(region.len() % 8, 0);
+        view::<u64>(region).fill(0);
         let base = region.as_mut_ptr();
         let mut desc = *desc;
         if desc.dim == 2 {
@@ -131,7 +139,7 @@ impl World {
             base.cast::<Header>().write(head);
             let world = core::ptr::slice_from_raw_parts_mut(base, layout.total) as *mut World;
             let world = &mut *world;
-            if desc.per_particle_mass {
+            if desc.has_masses() {
                 // Class 0 is the description's mass, for particles added without one.
                 world.planes::<i8>().1.mass_table[0] = desc.mass;
                 world.head.masses = 1;
@@ -196,8 +204,9 @@ impl World {
         &self.head.layout
     }
 
+    /// 2 or 3; 2 in a build without `dim3`, whose worlds are all 2D.
     pub(crate) fn dim(&self) -> usize {
-        self.head.desc.dim as usize
+        if cfg!(feature = "dim3") { self.head.desc.dim as usize } else { 2 }
     }
 
     /// The header and every plane, borrowed apart.
@@ -232,7 +241,13 @@ impl World {
     }
 
     pub(crate) fn plane<T: Plain>(&self, p: crate::layout::Plane) -> &[T] {
-        view_ref(&self.mem[p.off..p.off + p.len])
+        view_ref(self.plane_bytes(p))
+    }
+
+    /// The bytes of plane `p`: the part of [`World::plane`] that does not
+    /// depend on the type, so that it exists once.
+    fn plane_bytes(&self, p: crate::layout::Plane) -> &[u8] {
+        &self.mem[p.off..p.off + p.len]
     }
 
     /// The site of `pos`, or `OutOfBounds`.
@@ -253,8 +268,9 @@ impl World {
         test_bit(self.plane(self.layout().occupancy), s.bit)
     }
 
+    /// Whether cell `s` is an obstacle: never in a build without obstacles.
     pub(crate) fn is_obstacle(&self, s: Site) -> bool {
-        test_bit(self.plane(self.layout().obstacle), s.bit)
+        cfg!(feature = "obstacles") && test_bit(self.plane(self.layout().obstacle), s.bit)
     }
 }
 

@@ -142,9 +142,22 @@ pub struct mpca_desc {
     pub reserved: u32,
 }
 
+/// Description::new_2d's defaults as C sees them (the sizes aside), built
+/// at compile time: mpca_desc_defaults copies them.
+const DEFAULTS: mpca_desc = mpca_desc::from_core(&BASE);
+
+/// A core description to start from where every field is set after: a
+/// copy of a constant, less code than a call of new_2d.
+const BASE: Description = Description::new_2d(0, 0);
+
 const FORCE_BITS: u32 = mpca_force::Uniform as u32 | mpca_force::Field as u32 | mpca_force::Potential as u32 | mpca_force::Vortex as u32;
 
-fn boundary_to_c(b: Boundary) -> u32 {
+/// `term`'s bit of `mpca_desc.forces` where it is `on`, else 0.
+const fn force_bit(on: bool, term: mpca_force) -> u32 {
+    on as u32 * term as u32
+}
+
+const fn boundary_to_c(b: Boundary) -> u32 {
     match b {
         Boundary::Periodic => mpca_boundary::Periodic as u32,
         Boundary::Wall => mpca_boundary::Wall as u32,
@@ -162,28 +175,30 @@ fn boundary_from_c(v: u32) -> Result<Boundary, mpca_status> {
 }
 
 impl mpca_desc {
-    pub(crate) fn from_core(d: &Description) -> mpca_desc {
+    /// A constant function, so that [`DEFAULTS`] is built at compile time.
+    pub(crate) const fn from_core(d: &Description) -> mpca_desc {
         let f = d.forces;
+        let mut boundary = [[0; 2]; 3];
+        let mut k = 0;
+        while k < 3 {
+            boundary[k] = [boundary_to_c(d.boundary[k][0]), boundary_to_c(d.boundary[k][1])];
+            k += 1;
+        }
         mpca_desc {
             struct_size: core::mem::size_of::<mpca_desc>() as u32,
             dim: d.dim,
             seed: d.seed,
             size: d.size,
-            boundary: d.boundary.map(|a| a.map(boundary_to_c)),
+            boundary,
             mass: d.mass,
-            per_particle_mass: u32::from(d.per_particle_mass),
+            per_particle_mass: d.per_particle_mass as u32,
             mass_classes: d.mass_classes,
-            obstacles: u32::from(d.obstacles),
+            obstacles: d.obstacles as u32,
             surface_capacity: d.surface_capacity,
-            forces: [
-                (f.uniform, mpca_force::Uniform),
-                (f.field, mpca_force::Field),
-                (f.potential, mpca_force::Potential),
-                (f.vortex, mpca_force::Vortex),
-            ]
-            .iter()
-            .filter(|(on, _)| *on)
-            .fold(0, |bits, (_, bit)| bits | *bit as u32),
+            forces: force_bit(f.uniform, mpca_force::Uniform)
+                | force_bit(f.field, mpca_force::Field)
+                | force_bit(f.potential, mpca_force::Potential)
+                | force_bit(f.vortex, mpca_force::Vortex),
             gravity: d.gravity,
             vortex_centre: d.vortex.centre,
             vortex_core_radius: d.vortex.core_radius,
@@ -195,14 +210,14 @@ impl mpca_desc {
             drift: d.drift as u32,
             method: d.method as u32,
             emitter_capacity: d.emitter_capacity,
-            lifetimes: u32::from(d.lifetimes),
+            lifetimes: d.lifetimes as u32,
             collisions: d.collisions as u32,
-            contacts: u32::from(d.contacts),
-            energy_neutral: u32::from(d.energy_neutral),
+            contacts: d.contacts as u32,
+            energy_neutral: d.energy_neutral as u32,
             drag_rate: d.drag.rate,
             drag_wind: d.drag.wind,
-            drag_vortex: u32::from(d.drag.vortex),
-            drag_wind_field: u32::from(d.drag.field),
+            drag_vortex: d.drag.vortex as u32,
+            drag_wind_field: d.drag.field as u32,
             reserved: 0,
         }
     }
@@ -214,7 +229,9 @@ impl mpca_desc {
         if self.forces & !FORCE_BITS != 0 || self.reserved != 0 {
             return Err(mpca_status::BadEnum);
         }
-        let mut d = if self.dim == 3 { Description::new_3d(1, 1, 1) } else { Description::new_2d(1, 1) };
+        // Every field is set below: the constant only gives the
+        // non-exhaustive structure a start.
+        let mut d = BASE;
         d.dim = self.dim;
         d.seed = self.seed;
         d.size = self.size;
@@ -279,9 +296,10 @@ impl mpca_desc {
 pub unsafe extern "C" fn mpca_desc_defaults(out: *mut mpca_desc, dim: u32, nx: u32, ny: u32, nz: u32) -> mpca_status {
     guard(|c| {
         let out = c.out(out)?;
-        let d = if dim == 3 { Description::new_3d(nx, ny, nz) } else { Description::new_2d(nx, ny) };
-        let mut desc = mpca_desc::from_core(&d);
+        // Description::new_3d is new_2d with the dimension and nz set.
+        let mut desc = DEFAULTS;
         desc.dim = dim;
+        desc.size = [nx, ny, if dim == 3 { nz } else { 1 }];
         out.set(desc);
         Ok(())
     })
@@ -303,4 +321,26 @@ pub unsafe extern "C" fn mpca_world_bytes(desc: *const mpca_desc, out_bytes: *mu
         out.set(mpca_core::world_bytes(&d)?);
         Ok(())
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults_are_the_core_descriptions() {
+        // Expect: mpca_desc_defaults writes the core's new_2d and new_3d
+        // as C sees them, with the dimension it was given (any, even one
+        // the validation refuses later), and the core description back.
+        let mut four = Description::new_2d(6, 8);
+        four.dim = 4;
+        for (dim, core) in [(2, Description::new_2d(6, 8)), (3, Description::new_3d(6, 8, 10)), (4, four)] {
+            let mut out = DEFAULTS;
+            out.seed = 99;
+            // SAFETY: `out` is a valid, writable mpca_desc.
+            assert_eq!(unsafe { mpca_desc_defaults(&mut out, dim, 6, 8, 10) }, mpca_status::Ok);
+            assert_eq!(out, mpca_desc::from_core(&core), "dim {dim}");
+            assert_eq!(out.to_core(), Ok(core), "dim {dim}");
+        }
+    }
 }
