@@ -14,7 +14,8 @@
 #
 #   scripts/firmware.sh          the opt-level z build (what CI runs)
 #   scripts/firmware.sh --table  also opt-level s and 3 and an all-parts
-#                                library (dim3,obstacles,fields,mass,q16),
+#                                library (dim3,obstacles,fields,mass,q16,
+#                                all-methods,collision-rules),
 #                                and the host's instructions (callgrind)
 #
 # Boards: -M microbit (nRF51822, Cortex-M0, 16 KiB RAM) and -M mps2-an386
@@ -78,14 +79,14 @@ cpu_flags() {
 # `vortex` (the part of `fields` it uses); the 2D-only build has nothing
 # else (no dim3, obstacles, force fields, potentials, drag, per-particle
 # masses, 16-bit velocities), leaves out the lean block
-# routines (`small-step`), which a world with a vortex never takes, the
-# assignment methods the scene does not choose (`exact-fast-only`) and the
-# collision rules beyond the paper's (`paper-collisions-only`).
+# routines (`small-step`), which a world with a vortex never takes; being
+# without `all-methods` and `collision-rules`, it holds exact-fast alone
+# and the paper's collision rules. The all-parts build has every part.
 opt_level() { case $1 in all) echo z ;; *) echo "$1" ;; esac; }
 features() {
     case $1 in
-        all) echo dim3,obstacles,fields,mass,q16 ;;
-        *) echo vortex,small-step,exact-fast-only,paper-collisions-only ;;
+        all) echo dim3,obstacles,fields,mass,q16,all-methods,collision-rules ;;
+        *) echo vortex,small-step ;;
     esac
 }
 

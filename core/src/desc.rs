@@ -264,34 +264,34 @@ impl Description {
         cfg!(feature = "fields") && self.drag.rate > 0.0
     }
 
-    /// `method`, [`Method::ExactFast`] by construction in a build with the
-    /// feature `exact-fast-only` ([`Layout::of`] refuses the others there):
+    /// `method`, [`Method::ExactFast`] by construction in a build without
+    /// the feature `all-methods` ([`Layout::of`] refuses the others there):
     /// the step reads this, so such a build holds no code for the others.
     #[inline(always)]
     pub(crate) const fn assignment(&self) -> Method {
-        if cfg!(feature = "exact-fast-only") { Method::ExactFast } else { self.method }
+        if cfg!(feature = "all-methods") { self.method } else { Method::ExactFast }
     }
 
-    /// `collisions`, [`Collisions::Paper`] by construction in a build with
-    /// the feature `paper-collisions-only` ([`Layout::of`] refuses M5.2b
+    /// `collisions`, [`Collisions::Paper`] by construction in a build
+    /// without the feature `collision-rules` ([`Layout::of`] refuses M5.2b
     /// there), as [`Description::assignment`].
     #[inline(always)]
     pub(crate) const fn collision_rule(&self) -> Collisions {
-        if cfg!(feature = "paper-collisions-only") { Collisions::Paper } else { self.collisions }
+        if cfg!(feature = "collision-rules") { self.collisions } else { Collisions::Paper }
     }
 
-    /// `contacts` (M5.7), false by construction with the feature
-    /// `paper-collisions-only`, as [`Description::has_masses`].
+    /// `contacts` (M5.7), false by construction without the feature
+    /// `collision-rules`, as [`Description::has_masses`].
     #[inline(always)]
     pub(crate) const fn has_contacts(&self) -> bool {
-        !cfg!(feature = "paper-collisions-only") && self.contacts
+        cfg!(feature = "collision-rules") && self.contacts
     }
 
-    /// `energy_neutral` (M1b), false by construction with the feature
-    /// `paper-collisions-only`, as [`Description::has_masses`].
+    /// `energy_neutral` (M1b), false by construction without the feature
+    /// `collision-rules`, as [`Description::has_masses`].
     #[inline(always)]
     pub(crate) const fn has_energy_neutral(&self) -> bool {
-        !cfg!(feature = "paper-collisions-only") && self.energy_neutral
+        cfg!(feature = "collision-rules") && self.energy_neutral
     }
 }
 
@@ -316,18 +316,18 @@ mod tests {
     #[test]
     fn rules_a_build_left_out_are_refused() {
         // Expect: a description asking for an assignment method, a
-        // collision rule or a force the build left out (features
-        // `exact-fast-only`, `paper-collisions-only`; without `vortex`,
-        // `fields`) is refused with FeatureDisabled, and accepted by a
+        // collision rule or a force the build left out (without the
+        // features `all-methods`, `collision-rules`, `vortex`, `fields`) is
+        // refused with FeatureDisabled, and accepted by a
         // build that has it (the default); the paper's rules and
         // exact-fast are accepted by every build.
         let want = |left_out: bool| if left_out { Err(Error::FeatureDisabled) } else { Ok(()) };
         let plain = Description::new_2d(8, 8);
         for method in [Method::Exhaustive, Method::Greedy] {
             let d = Description { method, ..plain };
-            assert_eq!(d.validate(), want(cfg!(feature = "exact-fast-only")), "{method:?}");
+            assert_eq!(d.validate(), want(!cfg!(feature = "all-methods")), "{method:?}");
         }
-        let paper_only = want(cfg!(feature = "paper-collisions-only"));
+        let paper_only = want(!cfg!(feature = "collision-rules"));
         assert_eq!(Description { collisions: Collisions::SpeedLimited, ..plain }.validate(), paper_only, "M5.2b");
         assert_eq!(Description { contacts: true, ..plain }.validate(), paper_only, "M5.7");
         assert_eq!(Description { energy_neutral: true, ..plain }.validate(), paper_only, "M1b");

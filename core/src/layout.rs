@@ -158,8 +158,8 @@ impl Layout {
             || (d.obstacles && !cfg!(feature = "obstacles"))
             || ((d.forces.field || d.forces.potential || d.drag.rate > 0.0 || d.drag.field) && !cfg!(feature = "fields"))
             || (d.forces.vortex && !cfg!(feature = "vortex"))
-            || (d.method != Method::ExactFast && cfg!(feature = "exact-fast-only"))
-            || ((d.collisions != Collisions::Paper || d.contacts || d.energy_neutral) && cfg!(feature = "paper-collisions-only"))
+            || (d.method != Method::ExactFast && !cfg!(feature = "all-methods"))
+            || ((d.collisions != Collisions::Paper || d.contacts || d.energy_neutral) && !cfg!(feature = "collision-rules"))
         {
             return Err(Error::FeatureDisabled);
         }
