@@ -7,8 +7,7 @@
 use core::mem::{align_of, size_of};
 
 use crate::cells::Cells;
-use crate::assign::Method;
-use crate::desc::{finite, mass, restitution, Boundary, Collisions, Description, Quantization};
+use crate::desc::{finite, mass, restitution, Boundary, Description, Quantization};
 use crate::emitter::Slot;
 use crate::obstacle::Surface;
 use crate::Error;
@@ -154,13 +153,20 @@ impl Layout {
         if d.quantization == Quantization::Bits16 && !cfg!(feature = "q16") {
             return Err(Error::Q16Disabled);
         }
-        if (d.per_particle_mass && !cfg!(feature = "mass"))
-            || (d.obstacles && !cfg!(feature = "obstacles"))
-            || ((d.forces.field || d.forces.potential || d.drag.rate > 0.0 || d.drag.field) && !cfg!(feature = "fields"))
-            || (d.forces.vortex && !cfg!(feature = "vortex"))
-            || (d.method != Method::ExactFast && !cfg!(feature = "all-methods"))
-            || ((d.collisions != Collisions::Paper || d.contacts || d.energy_neutral) && !cfg!(feature = "collision-rules"))
-        {
+        // A part the build left out: the step reads the description through
+        // accessors that give what the build keeps (`has_masses`,
+        // `built_forces`, `assignment`, ...), so a description they would
+        // change asks for something missing. One map of features to parts.
+        let kept = d.has_masses() == d.per_particle_mass
+            && d.has_obstacles() == d.obstacles
+            && d.built_forces() == d.forces
+            && d.has_drag() == (d.drag.rate > 0.0)
+            && (cfg!(feature = "fields") || !d.drag.field)
+            && d.assignment() == d.method
+            && d.collision_rule() == d.collisions
+            && d.has_contacts() == d.contacts
+            && d.has_energy_neutral() == d.energy_neutral;
+        if !kept {
             return Err(Error::FeatureDisabled);
         }
         if d.per_particle_mass && !(1..=256).contains(&d.mass_classes) {
