@@ -222,20 +222,25 @@ impl World {
             rest = r;
             mine
         };
+        // A plane of a part the build leaves out is empty in every layout
+        // (`Layout::of` refuses a description that would need it): no
+        // split, and no code, for it.
+        let mut plane = |built: bool, p: crate::layout::Plane| -> &mut [u8] { if built { take(p) } else { &mut [] } };
+        let (obstacles, mass, fields) = (cfg!(feature = "obstacles"), cfg!(feature = "mass"), cfg!(feature = "fields"));
         let planes = Planes {
-            occupancy: view(take(l.occupancy)),
-            rows: take(l.rows),
-            words: view(take(l.words)),
-            obstacle: view(take(l.obstacle)),
-            velocity: view(take(l.velocity)),
-            mass_index: take(l.mass_index),
-            life: view(take(l.life)),
-            field: view(take(l.field)),
-            potential: view(take(l.potential)),
-            wind: view(take(l.wind)),
-            mass_table: view(take(l.mass_table)),
-            surface: view(take(l.surface)),
-            emitters: view(take(l.emitters)),
+            occupancy: view(plane(true, l.occupancy)),
+            rows: plane(true, l.rows),
+            words: view(plane(true, l.words)),
+            obstacle: view(plane(obstacles, l.obstacle)),
+            velocity: view(plane(true, l.velocity)),
+            mass_index: plane(mass, l.mass_index),
+            life: view(plane(true, l.life)),
+            field: view(plane(fields, l.field)),
+            potential: view(plane(fields, l.potential)),
+            wind: view(plane(fields, l.wind)),
+            mass_table: view(plane(mass, l.mass_table)),
+            surface: view(plane(obstacles, l.surface)),
+            emitters: view(plane(true, l.emitters)),
         };
         (&mut self.head, planes)
     }
