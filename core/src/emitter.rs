@@ -10,7 +10,7 @@ use crate::collision::random_unit;
 use crate::desc::finite;
 use crate::rng::{StepKey, Stream};
 use crate::vector::clamp;
-use crate::layout::Plain;
+use crate::layout::{view_first_ref, Plain};
 use crate::world::World;
 use crate::Error;
 
@@ -167,7 +167,9 @@ impl World {
     pub fn add_emitter(&mut self, e: Emitter) -> Result<usize, Error> {
         let e = checked(e, self.dim(), self.layout().n, self.head.desc.lifetimes)?;
         let used = self.head.emitters as usize;
-        if used >= self.layout().emitters.len / core::mem::size_of::<Slot>() {
+        // The capacity the plane was sized for (`Layout::of`), without a
+        // division by the slot's size.
+        if used >= self.head.desc.emitter_capacity as usize {
             return Err(Error::EmitterTableFull);
         }
         let mass_index = u32::from(self.mass_index_of(e.mass)?);
@@ -190,12 +192,17 @@ impl World {
         Ok(())
     }
 
+    /// The emitter table, as long as its capacity.
+    fn slots(&self) -> &[Slot] {
+        view_first_ref(self.plane_bytes(self.layout().emitters), self.head.desc.emitter_capacity as usize)
+    }
+
     /// Runs every emitter once (M6), at the start of a step.
     pub(crate) fn emit(&mut self) {
         let (seed, step, dim) = (self.head.desc.seed, self.head.step, self.dim());
         let key = StepKey::emitters(seed, step);
         for i in 0..self.head.emitters as usize {
-            let slot: Slot = self.plane::<Slot>(self.layout().emitters)[i];
+            let slot: Slot = self.slots()[i];
             let e = slot.emitter;
             let mut rng = key.stream(i as u64);
             let whole = libm::floorf(e.rate);

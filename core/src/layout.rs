@@ -60,6 +60,33 @@ pub(crate) fn view_ref<T: Plain>(bytes: &[u8]) -> &[T] {
     unsafe { core::slice::from_raw_parts(bytes.as_ptr().cast::<T>(), bytes.len() / size_of::<T>()) }
 }
 
+/// The first `count` values of `T` in `bytes`, or none where fewer fit.
+/// For a plane whose element count the header knows (the emitters: a
+/// structure of 56 bytes): [`view`] would divide by the size, which small
+/// cores call a routine for.
+#[inline]
+pub(crate) fn view_first<T: Plain>(bytes: &mut [u8], count: usize) -> &mut [T] {
+    let count = if fits::<T>(bytes.len(), count) { count } else { 0 };
+    debug_assert_eq!(bytes.as_ptr() as usize % align_of::<T>(), 0);
+    // SAFETY: as in `view`, for `count` values of T, which fit in `bytes`.
+    unsafe { core::slice::from_raw_parts_mut(bytes.as_mut_ptr().cast::<T>(), count) }
+}
+
+/// Read-only twin of [`view_first`].
+#[inline]
+pub(crate) fn view_first_ref<T: Plain>(bytes: &[u8], count: usize) -> &[T] {
+    let count = if fits::<T>(bytes.len(), count) { count } else { 0 };
+    debug_assert_eq!(bytes.as_ptr() as usize % align_of::<T>(), 0);
+    // SAFETY: as in `view_first`.
+    unsafe { core::slice::from_raw_parts(bytes.as_ptr().cast::<T>(), count) }
+}
+
+/// Whether `count` values of `T` fit in `len` bytes.
+#[inline]
+fn fits<T>(len: usize, count: usize) -> bool {
+    count.checked_mul(size_of::<T>()).is_some_and(|n| n <= len)
+}
+
 /// Where one plane lies in the world's memory, in bytes from its start.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub(crate) struct Plane {

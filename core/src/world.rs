@@ -9,7 +9,7 @@
 use core::mem::{align_of, size_of};
 
 use crate::desc::Description;
-use crate::layout::{test_bit, view, view_ref, Layout, Plain, Planes, Site};
+use crate::layout::{test_bit, view, view_first, view_ref, Layout, Plain, Planes, Site};
 use crate::Error;
 
 /// Counters the step keeps. All integers (clamped energy in 2^-32 units),
@@ -224,23 +224,23 @@ impl World {
         };
         // A plane of a part the build leaves out is empty in every layout
         // (`Layout::of` refuses a description that would need it): no
-        // split, and no code, for it.
-        let mut plane = |built: bool, p: crate::layout::Plane| -> &mut [u8] { if built { take(p) } else { &mut [] } };
+        // split, and no code, for it; an empty slice of its own type
+        // stands for it.
         let (obstacles, mass, fields) = (cfg!(feature = "obstacles"), cfg!(feature = "mass"), cfg!(feature = "fields"));
         let planes = Planes {
-            occupancy: view(plane(true, l.occupancy)),
-            rows: plane(true, l.rows),
-            words: view(plane(true, l.words)),
-            obstacle: view(plane(obstacles, l.obstacle)),
-            velocity: view(plane(true, l.velocity)),
-            mass_index: plane(mass, l.mass_index),
-            life: view(plane(true, l.life)),
-            field: view(plane(fields, l.field)),
-            potential: view(plane(fields, l.potential)),
-            wind: view(plane(fields, l.wind)),
-            mass_table: view(plane(mass, l.mass_table)),
-            surface: view(plane(obstacles, l.surface)),
-            emitters: view(plane(true, l.emitters)),
+            occupancy: view(take(l.occupancy)),
+            rows: take(l.rows),
+            words: view(take(l.words)),
+            obstacle: if obstacles { view(take(l.obstacle)) } else { &mut [] },
+            velocity: view(take(l.velocity)),
+            mass_index: if mass { take(l.mass_index) } else { &mut [] },
+            life: view(take(l.life)),
+            field: if fields { view(take(l.field)) } else { &mut [] },
+            potential: if fields { view(take(l.potential)) } else { &mut [] },
+            wind: if fields { view(take(l.wind)) } else { &mut [] },
+            mass_table: if mass { view(take(l.mass_table)) } else { &mut [] },
+            surface: if obstacles { view(take(l.surface)) } else { &mut [] },
+            emitters: view_first(take(l.emitters), self.head.desc.emitter_capacity as usize),
         };
         (&mut self.head, planes)
     }
@@ -251,7 +251,7 @@ impl World {
 
     /// The bytes of plane `p`: the part of [`World::plane`] that does not
     /// depend on the type, so that it exists once.
-    fn plane_bytes(&self, p: crate::layout::Plane) -> &[u8] {
+    pub(crate) fn plane_bytes(&self, p: crate::layout::Plane) -> &[u8] {
         &self.mem[p.off..p.off + p.len]
     }
 
