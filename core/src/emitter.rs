@@ -10,7 +10,7 @@ use crate::collision::random_unit;
 use crate::desc::finite;
 use crate::rng::{StepKey, Stream};
 use crate::vector::clamp;
-use crate::layout::{view_first_ref, Plain};
+use crate::layout::{view_counted_ref, Plain};
 use crate::world::World;
 use crate::Error;
 
@@ -194,7 +194,7 @@ impl World {
 
     /// The emitter table, as long as its capacity.
     fn slots(&self) -> &[Slot] {
-        view_first_ref(self.plane_bytes(self.layout().emitters), self.head.desc.emitter_capacity as usize)
+        view_counted_ref(self.plane_bytes(self.layout().emitters), self.head.desc.emitter_capacity as usize)
     }
 
     /// Runs every emitter once (M6), at the start of a step.

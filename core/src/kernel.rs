@@ -52,9 +52,18 @@ use crate::vector::{clamp_long, dot, dot_of, normalise};
 use crate::layout::{mark, put_bit};
 use crate::world::{Counters, ENERGY_SCALE};
 
+/// The description as a step's blocks read it: with `small-step` where it
+/// lies in the world's header (no copy to set up: less flash, a load more
+/// for each field a block reads), otherwise a copy beside the other
+/// shared data, which the lean routines read without that load.
+#[cfg(feature = "small-step")]
+pub(crate) type StepDescription<'a> = &'a Description;
+#[cfg(not(feature = "small-step"))]
+pub(crate) type StepDescription<'a> = Description;
+
 /// What every block of a step reads and none writes.
 pub(crate) struct Shared<'a> {
-    pub desc: Description,
+    pub desc: StepDescription<'a>,
     pub n: [usize; 3],
     pub part: Partition,
     pub key: StepKey,

@@ -60,24 +60,31 @@ pub(crate) fn view_ref<T: Plain>(bytes: &[u8]) -> &[T] {
     unsafe { core::slice::from_raw_parts(bytes.as_ptr().cast::<T>(), bytes.len() / size_of::<T>()) }
 }
 
-/// The first `count` values of `T` in `bytes`, or none where fewer fit.
-/// For a plane whose element count the header knows (the emitters: a
-/// structure of 56 bytes): [`view`] would divide by the size, which small
-/// cores call a routine for.
+/// `bytes` as values of `T`, whose plane [`Layout::of`] sized for `count`
+/// of them (the emitters: a structure of 56 bytes). With `small-step`
+/// (firmware) the first `count` (none where fewer fit), without the
+/// division by the size that [`view`] makes, which small cores call a
+/// routine for; otherwise [`view`], the same values.
 #[inline]
-pub(crate) fn view_first<T: Plain>(bytes: &mut [u8], count: usize) -> &mut [T] {
+pub(crate) fn view_counted<T: Plain>(bytes: &mut [u8], count: usize) -> &mut [T] {
+    if !cfg!(feature = "small-step") {
+        return view(bytes);
+    }
     let count = if fits::<T>(bytes.len(), count) { count } else { 0 };
     debug_assert_eq!(bytes.as_ptr() as usize % align_of::<T>(), 0);
     // SAFETY: as in `view`, for `count` values of T, which fit in `bytes`.
     unsafe { core::slice::from_raw_parts_mut(bytes.as_mut_ptr().cast::<T>(), count) }
 }
 
-/// Read-only twin of [`view_first`].
+/// Read-only twin of [`view_counted`].
 #[inline]
-pub(crate) fn view_first_ref<T: Plain>(bytes: &[u8], count: usize) -> &[T] {
+pub(crate) fn view_counted_ref<T: Plain>(bytes: &[u8], count: usize) -> &[T] {
+    if !cfg!(feature = "small-step") {
+        return view_ref(bytes);
+    }
     let count = if fits::<T>(bytes.len(), count) { count } else { 0 };
     debug_assert_eq!(bytes.as_ptr() as usize % align_of::<T>(), 0);
-    // SAFETY: as in `view_first`.
+    // SAFETY: as in `view_counted`.
     unsafe { core::slice::from_raw_parts(bytes.as_ptr().cast::<T>(), count) }
 }
 

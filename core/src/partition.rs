@@ -255,8 +255,10 @@ impl Partition {
         while j < total {
             let i = if reverse { band.end - 1 - j } else { band.start + j };
             // In 2D the grid has one layer of rows of blocks (`az.blocks`
-            // is 1): no division, which small cores call a routine for.
-            let (by, bz) = if dim == 2 { (i, 0) } else { (i % ay.blocks, i / ay.blocks) };
+            // is 1). With `small-step` (firmware) no division for it, which
+            // small cores call a routine for; otherwise the remainder tells
+            // the compiler `by < ay.blocks`, which spares checks below.
+            let (by, bz) = if dim == 2 && cfg!(feature = "small-step") { (i, 0) } else { (i % ay.blocks, i / ay.blocks) };
             let origin = [ay.first + 2 * by as isize, az.first + 2 * bz as isize];
             let (ys, y_out) = self.axis_pair(1, origin[0]);
             let (zs, z_out) = self.axis_pair(2, origin[1]);

@@ -158,8 +158,12 @@ impl Stream {
 /// `a % n` (`n >= 1`) by shifts and subtractions, a bit at a time: the
 /// rejection threshold of [`Stream::below`], which a draw needs once in
 /// thousands, without the division routine that small cores (Cortex-M0)
-/// would otherwise link for it.
+/// would otherwise link for it: with `small-step` (firmware) only, since
+/// hosts divide in one instruction.
 fn remainder(a: u32, n: u32) -> u32 {
+    if !cfg!(feature = "small-step") {
+        return a % n;
+    }
     let mut r = 0u64;
     for i in (0..32).rev() {
         r = r << 1 | u64::from(a >> i & 1);

@@ -9,7 +9,7 @@
 use core::mem::{align_of, size_of};
 
 use crate::desc::Description;
-use crate::layout::{test_bit, view, view_first, view_ref, Layout, Plain, Planes, Site};
+use crate::layout::{test_bit, view, view_counted, view_ref, Layout, Plain, Planes, Site};
 use crate::Error;
 
 /// Counters the step keeps. All integers (clamped energy in 2^-32 units),
@@ -240,7 +240,7 @@ impl World {
             wind: if fields { view(take(l.wind)) } else { &mut [] },
             mass_table: if mass { view(take(l.mass_table)) } else { &mut [] },
             surface: if obstacles { view(take(l.surface)) } else { &mut [] },
-            emitters: view_first(take(l.emitters), self.head.desc.emitter_capacity as usize),
+            emitters: view_counted(take(l.emitters), self.head.desc.emitter_capacity as usize),
         };
         (&mut self.head, planes)
     }
