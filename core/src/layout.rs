@@ -208,44 +208,52 @@ impl Layout {
         }
 
         // Cell indices are stored as u32 (surface table), so the cell count
-        // must fit one; every byte count below is checked against usize.
-        let cells = n[0].checked_mul(n[1]).and_then(|c| c.checked_mul(n[2])).ok_or(Error::TooLarge)?;
+        // must fit one; every byte count below is checked against usize,
+        // and any that overflows is the one error TooLarge.
+        let cells = mul(mul(n[0], n[1])?, n[2])?;
         if u32::try_from(cells).is_err() {
             return Err(Error::TooLarge);
         }
+        let rows = n[1] * n[2];
         let row_words = row_words(n[0]);
-        let bit_plane = row_words.checked_mul(n[1] * n[2]).and_then(|w| w.checked_mul(8)).ok_or(Error::TooLarge)?;
+        let bit_plane = mul(mul(row_words, rows)?, 8)?;
         // Bit planes are indexed by bit, so their bit count must fit too.
-        bit_plane.checked_mul(8).ok_or(Error::TooLarge)?;
+        mul(bit_plane, 8)?;
         let q = match d.quantization {
             Quantization::Bits8 => 1,
             Quantization::Bits16 => 2,
         };
-        let per_cell = |bytes: usize, on: bool| -> Result<usize, Error> {
-            if on { cells.checked_mul(bytes).ok_or(Error::TooLarge) } else { Ok(0) }
-        };
-        let mut b = Builder { at: 0 };
-        let occupancy = b.plane(bit_plane)?;
-        let rows = b.plane(n[1] * n[2])?;
+        // `bytes` a cell where `on`.
+        let per_cell = |bytes: usize, on: bool| mul(cells, bytes * usize::from(on));
         let summary_words = row_words.div_ceil(64);
-        let words = b.plane(summary_words * n[1] * n[2] * 8)?;
-        let obstacle = b.plane(if d.obstacles { bit_plane } else { 0 })?;
-        let velocity = b.plane(per_cell(dim * q, true)?)?;
-        let mass_index = b.plane(per_cell(1, d.per_particle_mass)?)?;
-        let life = b.plane(per_cell(2, d.lifetimes)?)?;
-        let field = b.plane(per_cell(dim * 4, d.forces.field)?)?;
-        let potential = b.plane(per_cell(4, d.forces.potential)?)?;
-        let wind = b.plane(per_cell(dim * 4, d.drag.field)?)?;
-        let mass_table = b.plane(if d.per_particle_mass { d.mass_classes as usize * 4 } else { 0 })?;
-        let surface_len = if d.obstacles {
-            (d.surface_capacity as usize).checked_mul(core::mem::size_of::<crate::obstacle::Surface>()).ok_or(Error::TooLarge)?
-        } else {
-            0
-        };
-        let surface = b.plane(surface_len)?;
-        let emitters = b.plane(
-            (d.emitter_capacity as usize).checked_mul(core::mem::size_of::<crate::emitter::Slot>()).ok_or(Error::TooLarge)?,
-        )?;
+        // The planes' lengths in the order they lie in memory, each
+        // starting 8-byte aligned after the one before.
+        let lens = [
+            bit_plane,
+            rows,
+            summary_words * rows * 8,
+            bit_plane * usize::from(d.obstacles),
+            per_cell(dim * q, true)?,
+            per_cell(1, d.per_particle_mass)?,
+            per_cell(2, d.lifetimes)?,
+            per_cell(dim * 4, d.forces.field)?,
+            per_cell(4, d.forces.potential)?,
+            per_cell(dim * 4, d.drag.field)?,
+            if d.per_particle_mass { d.mass_classes as usize * 4 } else { 0 },
+            mul(d.surface_capacity as usize * usize::from(d.obstacles), size_of::<crate::obstacle::Surface>())?,
+            mul(d.emitter_capacity as usize, size_of::<crate::emitter::Slot>())?,
+        ];
+        let mut planes = [Plane::default(); 13];
+        let mut at = 0usize;
+        for (plane, len) in planes.iter_mut().zip(lens) {
+            *plane = Plane { off: at, len };
+            at = at.checked_add(len).and_then(|e| e.checked_add(7)).ok_or(Error::TooLarge)? & !7;
+            // Slices may not exceed isize::MAX bytes.
+            if at > isize::MAX as usize / 2 {
+                return Err(Error::TooLarge);
+            }
+        }
+        let [occupancy, rows, words, obstacle, velocity, mass_index, life, field, potential, wind, mass_table, surface, emitters] = planes;
         Ok(Layout {
             n,
             cells,
@@ -264,26 +272,16 @@ impl Layout {
             mass_table,
             surface,
             emitters,
-            total: b.at,
+            total: at,
         })
     }
 }
 
-struct Builder {
-    at: usize,
-}
-
-impl Builder {
-    fn plane(&mut self, len: usize) -> Result<Plane, Error> {
-        let off = self.at;
-        let end = off.checked_add(len).and_then(|e| e.checked_add(7)).ok_or(Error::TooLarge)? & !7;
-        // Slices may not exceed isize::MAX bytes.
-        if end > isize::MAX as usize / 2 {
-            return Err(Error::TooLarge);
-        }
-        self.at = end;
-        Ok(Plane { off, len })
-    }
+/// `a * b`, or `TooLarge` where it overflows. Out of line: one copy for
+/// every size [`Layout::of`] checks.
+#[inline(never)]
+fn mul(a: usize, b: usize) -> Result<usize, Error> {
+    a.checked_mul(b).ok_or(Error::TooLarge)
 }
 
 /// Mutable views of every plane, borrowed together.
