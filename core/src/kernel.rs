@@ -991,8 +991,8 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
         let at = |c: usize| [x0 as i64 + (c & 1) as i64, row.origin[0] as i64 + ((c >> 1) & 1) as i64, row.origin[1] as i64 + ((c >> 2) & 1) as i64];
         let mut outside = row.outside;
         if x_out != 0 {
-            let low = if x_out & 1 != 0 { cells_at(0, 0, D) } else { 0 };
-            outside |= low | if x_out & 2 != 0 { cells_at(0, 1, D) } else { 0 };
+            let low = if x_out & 1 != 0 { const { cells_at(0, 0, D) } } else { 0 };
+            outside |= low | if x_out & 2 != 0 { const { cells_at(0, 1, D) } } else { 0 };
         }
         // The cells beyond a face are wall or open (their sites mean
         // nothing).

@@ -268,7 +268,10 @@ impl Partition {
             for dz in 0..layers {
                 for dy in 0..2 {
                     if (y_out >> dy | z_out >> dz) & 1 != 0 {
-                        outside |= cells_at(1, dy, dim) & cells_at(2, dz, dim);
+                        // The masks as constants (no call at opt-level z).
+                        let y = if dy == 0 { const { cells_at(1, 0, S::DIM) } } else { const { cells_at(1, 1, S::DIM) } };
+                        let z = if dz == 0 { const { cells_at(2, 0, S::DIM) } } else { const { cells_at(2, 1, S::DIM) } };
+                        outside |= y & z;
                         continue;
                     }
                     let l = ys[dy] + ay.n * zs[dz];
