@@ -211,11 +211,13 @@ impl World {
             if wanted == 0 {
                 continue;
             }
-            let l = *self.layout();
-            let mut free = 0u64;
-            each_site(&l, &e, |s| free += u64::from(!self.occupied(s) && !self.is_obstacle(s)));
-            let placing = wanted.min(free);
-            self.head.counters.shortfall = self.head.counters.shortfall.saturating_add(wanted - placing);
+            let grid = self.layout().grid();
+            // Cells, counted in machine words (not u64: small cores add
+            // those in pairs of instructions).
+            let mut free = 0usize;
+            each_site(grid, &e, |s| free += usize::from(!self.occupied(s) && !self.is_obstacle(s)));
+            let placing = wanted.min(free as u64) as usize;
+            self.head.counters.shortfall = self.head.counters.shortfall.saturating_add(wanted - placing as u64);
             let mut need = placing;
             let mut left = free;
             let mut chosen = |w: &mut World, s| {
@@ -225,7 +227,7 @@ impl World {
                 // Selection sampling: take this cell with chance need/left,
                 // which picks a uniform subset of `placing` free cells.
                 // `left` counts cells, so it fits the u32 of `below`.
-                let take = u64::from(rng.below(left as u32)) < need;
+                let take = (rng.below(left as u32) as usize) < need;
                 left -= 1;
                 if take {
                     need -= 1;
@@ -233,16 +235,16 @@ impl World {
                     w.place_emitted(s, v, slot.mass_index as u8, e.lifetime as u16, &mut rng);
                 }
             };
-            each_site(&l, &e, |s| chosen(self, s));
+            each_site(grid, &e, |s| chosen(self, s));
             // Saturating: an image (M12) may carry any count.
-            self.head.counters.emitted = self.head.counters.emitted.saturating_add(placing);
-            self.head.counters.particles += placing;
+            self.head.counters.emitted = self.head.counters.emitted.saturating_add(placing as u64);
+            self.head.counters.particles += placing as u64;
         }
     }
 }
 
 /// Calls `f` with every site of the emitter's region.
-fn each_site(l: &crate::layout::Layout, e: &Emitter, mut f: impl FnMut(crate::layout::Site)) {
+fn each_site(l: crate::layout::Grid, e: &Emitter, mut f: impl FnMut(crate::layout::Site)) {
     for z in e.min[2] as usize..e.max[2] as usize {
         for y in e.min[1] as usize..e.max[1] as usize {
             for x in e.min[0] as usize..e.max[0] as usize {

@@ -351,6 +351,28 @@ impl Layout {
     /// The site of in-range coordinates.
     #[inline]
     pub(crate) fn site(&self, x: usize, y: usize, z: usize) -> Site {
+        self.grid().site(x, y, z)
+    }
+
+    /// What [`Layout::site`] reads, apart: a copy of three words where a
+    /// caller must let go of the world (the emitters' placement).
+    #[inline]
+    pub(crate) fn grid(&self) -> Grid {
+        Grid { n: self.n, row_words: self.row_words }
+    }
+}
+
+/// The cells per axis and the words per bit-plane row of a [`Layout`].
+#[derive(Clone, Copy)]
+pub(crate) struct Grid {
+    n: [usize; 3],
+    row_words: usize,
+}
+
+impl Grid {
+    /// The site of in-range coordinates.
+    #[inline]
+    pub(crate) fn site(&self, x: usize, y: usize, z: usize) -> Site {
         let row = y + self.n[1] * z;
         Site { cell: x + self.n[0] * row, bit: row * self.row_words * 64 + x, row, x }
     }
