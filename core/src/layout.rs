@@ -317,8 +317,14 @@ pub(crate) struct Site {
 /// Notes that cell `x` of row `row` now holds a particle: sets the row's
 /// flag and its summary bit for the occupancy word holding the cell, so the
 /// step does not skip them (M3). `summary_words` words per row.
+///
+/// With `small-step` nothing: that build's sweep reads neither
+/// ([`crate::partition::Partition::sweep_band`]).
 #[inline]
 pub(crate) fn mark(rows: Cells<'_, u8>, words: Cells<'_, u64>, summary_words: usize, row: usize, x: usize) {
+    if cfg!(feature = "small-step") {
+        return;
+    }
     rows.set(row, 1);
     let w = x >> 6;
     let at = row * summary_words + (w >> 6);
