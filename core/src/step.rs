@@ -157,10 +157,13 @@ impl World {
         route: Route,
         visit: impl FnOnce(&Shared<'_>, Writable<'_, Q, D>, bool) -> Counters,
     ) {
-        let Setup { counters, shared, velocity, occupancy, rows, words, mass_index, life } = self.setup(route, Q::SCALE);
-        let planes = Writable { occupancy, rows, words, velocity: Cells::new(groups(view::<Q>(velocity))), mass_index, life };
-        let c = visit(&shared, planes, route.reverse);
-        count_step(counters, &c, shared.part.total_blocks());
+        // The shared data read where `setup` wrote it (moved out, it would
+        // be a copy of some 280 bytes).
+        let s = self.setup(route, Q::SCALE);
+        let velocity = Cells::new(groups(view::<Q>(s.velocity)));
+        let planes = Writable { occupancy: s.occupancy, rows: s.rows, words: s.words, velocity, mass_index: s.mass_index, life: s.life };
+        let c = visit(&s.shared, planes, route.reverse);
+        count_step(s.counters, &c, s.shared.part.total_blocks());
     }
 
     /// A step's [`Setup`] for a velocity width of `scale` quanta per unit
