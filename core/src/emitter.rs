@@ -51,10 +51,11 @@ unsafe impl Plain for Slot {}
 /// `lifetimes`, an age plane stores it (2D drops the third axis), or why
 /// such a world refuses it. Shared by [`World::add_emitter`] and the
 /// snapshot loader (M12), which holds a stored emitter to the same rules.
-pub(crate) fn checked(e: Emitter, dim: usize, n: [usize; 3], lifetimes: bool) -> Result<Emitter, Error> {
+/// `e` is changed in place, refused or not (no copy of it in or out, each
+/// a `memcpy` call on a small core): callers check a copy of their own.
+pub(crate) fn checked(e: &mut Emitter, dim: usize, n: [usize; 3], lifetimes: bool) -> Result<(), Error> {
     // Every float is checked as given, before 2D drops the third axis.
     finite(&[e.rate, e.velocity[0], e.velocity[1], e.velocity[2], e.spread])?;
-    let mut e = e;
     if dim == 2 {
         e.min[2] = 0;
         e.max[2] = 1;
@@ -72,7 +73,7 @@ pub(crate) fn checked(e: Emitter, dim: usize, n: [usize; 3], lifetimes: bool) ->
     if e.lifetime > 0 && !lifetimes {
         return Err(Error::NotEnabled);
     }
-    Ok(e)
+    Ok(())
 }
 
 /// Whether `|v| + spread > 1`, decided exactly, for finite `v` and
@@ -164,8 +165,8 @@ impl Wide {
 
 impl World {
     /// Adds an emitter and returns its index.
-    pub fn add_emitter(&mut self, e: Emitter) -> Result<usize, Error> {
-        let e = checked(e, self.dim(), self.layout().n, self.head.desc.lifetimes)?;
+    pub fn add_emitter(&mut self, mut e: Emitter) -> Result<usize, Error> {
+        checked(&mut e, self.dim(), self.layout().n, self.head.desc.lifetimes)?;
         let used = self.head.emitters as usize;
         // The capacity the plane was sized for (`Layout::of`), without a
         // division by the slot's size.
