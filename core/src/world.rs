@@ -116,32 +116,27 @@ impl World {
         debug_assert_eq!(region.len() % 8, 0);
         view::<u64>(region).fill(0);
         let base = region.as_mut_ptr();
-        let mut desc = *desc;
-        if desc.dim == 2 {
-            desc.size[2] = 1;
-        }
-        let head = Header {
-            tag: TAG ^ base as u64,
-            len: layout.total,
-            desc,
-            layout,
-            step: 0,
-            counters: Counters::default(),
-            masses: 0,
-            surfaces: 0,
-            emitters: 0,
-            owned: 0,
-        };
+        let h = base.cast::<Header>();
         // SAFETY: `base` is aligned for Header (pad above) and the region
-        // holds size_of::<Header>() + layout.total bytes, borrowed for 'a.
-        // The fat pointer's metadata is the length of the trailing [u8].
+        // holds size_of::<Header>() + layout.total bytes, borrowed for 'a
+        // and all 0. The fields are written in place (a Header built on the
+        // stack and copied over would be a `memcpy` of some 390 bytes);
+        // those not written (the step, the counters and the table counts)
+        // are integers, for which the zero bytes are the value 0. The fat
+        // pointer's metadata is the length of the trailing [u8].
         unsafe {
-            base.cast::<Header>().write(head);
+            core::ptr::addr_of_mut!((*h).tag).write(TAG ^ base as u64);
+            core::ptr::addr_of_mut!((*h).len).write(layout.total);
+            core::ptr::addr_of_mut!((*h).desc).write(*desc);
+            core::ptr::addr_of_mut!((*h).layout).write(layout);
             let world = core::ptr::slice_from_raw_parts_mut(base, layout.total) as *mut World;
             let world = &mut *world;
-            if desc.has_masses() {
+            if world.head.desc.dim == 2 {
+                world.head.desc.size[2] = 1;
+            }
+            if world.head.desc.has_masses() {
                 // Class 0 is the description's mass, for particles added without one.
-                world.planes::<i8>().1.mass_table[0] = desc.mass;
+                world.planes::<i8>().1.mass_table[0] = world.head.desc.mass;
                 world.head.masses = 1;
             }
             Ok(world)
