@@ -316,7 +316,8 @@ impl Partition {
     /// every row.
     fn sweep_band_small<'a, S: BlockSink<'a>>(&self, sink: &mut S, band: Range<usize>, reverse: bool) {
         let occupancy = sink.index().occupancy;
-        let [ax, ay, az] = self.axes;
+        // By reference: a copy of the axes is a memcpy call at opt-level z.
+        let [ax, ay, az] = &self.axes;
         // Offset 1 on a periodic x axis: the last block holds cells n - 1
         // and 0; bit 0 of a row is that block's, not block 0's.
         let wraps = ax.first == 1;
