@@ -309,8 +309,8 @@ fn read_block<const CELLS: usize>(plane: &[u64], row: &BlockRow, xs: [usize; 2])
 /// A unit normal from cell `to` back towards cell `from` of the same block.
 pub(crate) fn back_normal<const D: usize>(from: usize, to: usize) -> [f32; 3] {
     let mut n = [0.0f32; 3];
-    for (k, nk) in n.iter_mut().enumerate().take(D) {
-        *nk = ((from >> k) & 1) as f32 - ((to >> k) & 1) as f32;
+    for k in 0..D {
+        n[k] = ((from >> k) & 1) as f32 - ((to >> k) & 1) as f32;
     }
     normalise(n).unwrap_or([0.0; 3])
 }
@@ -1039,8 +1039,13 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
                 let pos = sh.part.cell_coords(row, [xs[c & 1], 0, 0], c);
                 // dt = 0 changes nothing, even under an infinite force
                 // (0 * inf would be NaN).
-                let a = sh.terms.accel(pos, cell(c), mass[c]);
-                a.map(|a| if sh.dt_q == 0.0 { 0.0 } else { a * sh.dt_q })
+                let mut a = sh.terms.accel(pos, cell(c), mass[c]);
+                // Component by component: an array's map is a call at
+                // opt-level z.
+                for a in &mut a {
+                    *a = if sh.dt_q == 0.0 { 0.0 } else { *a * sh.dt_q };
+                }
+                a
             } else {
                 sh.push.unwrap_or_default()
             };

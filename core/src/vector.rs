@@ -19,6 +19,14 @@ pub(crate) fn dot_of<const D: usize>(a: [f32; 3], b: [f32; 3]) -> f32 {
     sum
 }
 
+/// The larger of `a` and `b`, neither of them NaN: `f32::max` without the
+/// library's `fmaxf` (a call on cores without the instruction), whose NaN
+/// rules such inputs never need.
+#[inline(always)]
+pub(crate) fn larger(a: f32, b: f32) -> f32 {
+    if a > b { a } else { b }
+}
+
 /// `v / |v|`, or `None` where the length is zero or not finite.
 pub(crate) fn normalise(v: [f32; 3]) -> Option<[f32; 3]> {
     let len = libm::sqrtf(dot(v, v));
@@ -62,7 +70,7 @@ pub(crate) fn clamp_long(mut v: [f32; 3], s2: f32, limit: f32) -> ([f32; 3], f32
         for c in v.iter_mut() {
             *c /= limit;
         }
-        let big = v.iter().filter(|c| !c.is_nan()).fold(0.0f32, |b, c| b.max(c.abs()));
+        let big = v.iter().filter(|c| !c.is_nan()).fold(0.0f32, |b, c| larger(b, c.abs()));
         for c in v.iter_mut() {
             *c = if c.is_nan() || big == 0.0 {
                 0.0
