@@ -208,7 +208,7 @@ impl World {
             let mut rng = key.stream(i as u64);
             let whole = whole_part(e.rate);
             // Casting saturates, so an absurd rate asks for u64::MAX.
-            let wanted = (whole as u64).saturating_add(u64::from(rng.chance(e.rate - whole)));
+            let wanted = crate::vector::saturating_u64(whole).saturating_add(u64::from(rng.chance(e.rate - whole)));
             if wanted == 0 {
                 continue;
             }

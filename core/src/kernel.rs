@@ -343,7 +343,7 @@ fn clamp_and_count(x: [f32; 3], s2: f32, scale: f32, m: f32, counters: &mut Coun
     counters.clamps += 1;
     // f32 and a saturating cast: no f64 or 128-bit arithmetic, which small
     // cores emulate; f32's 24 bits are far finer than the statistic needs.
-    let fixed = (0.5 * m * (s2 - 1.0) * ENERGY_SCALE as f32) as u64;
+    let fixed = crate::vector::saturating_u64(0.5 * m * (s2 - 1.0) * ENERGY_SCALE as f32);
     counters.clamp_energy = counters.clamp_energy.saturating_add(fixed);
     x
 }

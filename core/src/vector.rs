@@ -27,6 +27,26 @@ pub(crate) fn larger(a: f32, b: f32) -> f32 {
     if a > b { a } else { b }
 }
 
+/// `x as u64` (toward zero; NaN and below 0 give 0, from 2^64 on
+/// `u64::MAX`) from the bits of `x`: on 32-bit cores the cast is a library
+/// routine of some 80 bytes.
+pub(crate) fn saturating_u64(x: f32) -> u64 {
+    let bits = x.to_bits();
+    // Negative (sign set) or NaN (above the bits of infinity): 0.
+    if bits >= 0x8000_0000 || bits > 0x7f80_0000 {
+        return 0;
+    }
+    let exponent = (bits >> 23) as i32 - 127;
+    if exponent < 0 {
+        return 0;
+    }
+    if exponent >= 64 {
+        return u64::MAX;
+    }
+    let mantissa = u64::from(bits & 0x7f_ffff | 0x80_0000);
+    if exponent >= 23 { mantissa << (exponent - 23) } else { mantissa >> (23 - exponent) }
+}
+
 /// `v / |v|`, or `None` where the length is zero or not finite.
 pub(crate) fn normalise(v: [f32; 3]) -> Option<[f32; 3]> {
     let len = libm::sqrtf(dot(v, v));
@@ -100,6 +120,26 @@ pub(crate) fn clamp_long(mut v: [f32; 3], s2: f32, limit: f32) -> ([f32; 3], f32
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn saturating_u64_is_the_cast() {
+        // Expect: `as u64` bit for bit, for every exponent's neighbours,
+        // both signs, zeros, infinities, NaNs and random bit patterns.
+        let check = |x: f32| assert_eq!(saturating_u64(x), x as u64, "{x:e} {:#x}", x.to_bits());
+        for e in 0..256u32 {
+            for k in 0..4 {
+                for sign in [0, 0x8000_0000] {
+                    check(f32::from_bits(sign | (e << 23) + k));
+                    check(f32::from_bits(sign | ((e << 23) | 0x7f_ffff) - k));
+                }
+            }
+        }
+        let mut bits = 0x1234_5678u32;
+        for _ in 0..crate::sized(200_000, 2_000) {
+            bits = bits.wrapping_mul(0x9e37_79b9).wrapping_add(0x7f4a_7c15);
+            check(f32::from_bits(bits));
+        }
+    }
 
     #[test]
     fn clamp_survives_overflow() {
