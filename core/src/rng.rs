@@ -164,14 +164,17 @@ fn remainder(a: u32, n: u32) -> u32 {
     if !cfg!(feature = "small-step") {
         return a % n;
     }
-    let mut r = 0u64;
+    // r < n before each step; doubled plus a bit it is below 2n, which
+    // may pass 2^32 (the bit shifted out): then it is n or more.
+    let mut r = 0u32;
     for i in (0..32).rev() {
-        r = r << 1 | u64::from(a >> i & 1);
-        if r >= u64::from(n) {
-            r -= u64::from(n);
+        let carry = r >> 31;
+        r = r << 1 | (a >> i & 1);
+        if carry != 0 || r >= n {
+            r = r.wrapping_sub(n);
         }
     }
-    r as u32
+    r
 }
 
 /// The stream of block `block` (its index in the step's block grid) at `step`.
