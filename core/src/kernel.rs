@@ -1030,6 +1030,9 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
                 life[c] = self.planes.life.get(cell(c));
             }
         }
+        // A cell's mass: the world's one where particles carry none (no
+        // array read, so no bounds check, in a build without masses).
+        let mass_of = |c: usize| if desc.has_masses() { mass[c] } else { desc.mass };
         let mut rng = sh.key.stream(row.index + bx as u64);
         let mut bytes = None;
 
@@ -1039,7 +1042,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
                 let pos = sh.part.cell_coords(row, [xs[c & 1], 0, 0], c);
                 // dt = 0 changes nothing, even under an infinite force
                 // (0 * inf would be NaN).
-                let mut a = sh.terms.accel(pos, cell(c), mass[c]);
+                let mut a = sh.terms.accel(pos, cell(c), mass_of(c));
                 // Component by component: an array's map is a call at
                 // opt-level z.
                 for a in &mut a {
@@ -1052,7 +1055,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
             // A force that changes nothing is no step 1: a zero-valued part
             // gives the same world as a world without it (M9).
             if dv != [0.0; 3] {
-                self.push(&mut b, c, dv, mass[c]);
+                self.push(&mut b, c, dv, mass_of(c));
             }
         }
 
@@ -1067,14 +1070,14 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
                 for k in 0..D {
                     x[k] = (x[k] + a * u[k]) / (1.0 + a);
                 }
-                clamp_counted::<D>(&mut x, Q::SCALE, mass[c], &mut self.counters);
+                clamp_counted::<D>(&mut x, Q::SCALE, mass_of(c), &mut self.counters);
                 b.set(c, x);
             }
         }
 
         // M5.2 collision, then M1 for what the force, the drag and the
         // collision changed.
-        self.collide(&mut b, &mut rng, |c| mass[c], !desc.has_masses());
+        self.collide(&mut b, &mut rng, mass_of, !desc.has_masses());
         b.round::<Q>(&mut rng);
 
         // M5.3 desired move, M5.4 obstacle reflection: `want[c]` holds the
@@ -1088,7 +1091,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
             if m != 0 && blocked >> t & 1 != 0 {
                 let to = Wanted { cell: t, site: cell(t), at: at(t), wall: wall >> t & 1 != 0 };
                 // M5.4, its new velocity rounded at once (M1).
-                if let Some(x) = reflect_off::<D>(sh, b.velocity(c), c, to, mass[c], Q::SCALE, &mut self.counters) {
+                if let Some(x) = reflect_off::<D>(sh, b.velocity(c), c, to, mass_of(c), Q::SCALE, &mut self.counters) {
                     b.set(c, x);
                     b.round_apart::<Q>(&mut rng);
                 }
