@@ -33,18 +33,20 @@ impl Counters {
     /// Adds what a sweep of blocks counts (a task's share of a step). The
     /// running totals saturate: an image (M12) may carry any count.
     pub fn add_step(&mut self, c: &Counters) {
-        for (total, add) in [
-            (&mut self.exited, c.exited),
-            (&mut self.expired, c.expired),
-            (&mut self.collisions, c.collisions),
-            (&mut self.clamps, c.clamps),
-            (&mut self.clamp_energy, c.clamp_energy),
-            (&mut self.displaced, c.displaced),
-            (&mut self.processed, c.processed),
-        ] {
-            *total = total.saturating_add(add);
-        }
+        add(&mut self.exited, c.exited);
+        add(&mut self.expired, c.expired);
+        add(&mut self.collisions, c.collisions);
+        add(&mut self.clamps, c.clamps);
+        add(&mut self.clamp_energy, c.clamp_energy);
+        add(&mut self.displaced, c.displaced);
+        add(&mut self.processed, c.processed);
     }
+}
+
+/// `total += more`, saturating. Out of line: one copy for every counter.
+#[inline(never)]
+fn add(total: &mut u64, more: u64) {
+    *total = total.saturating_add(more);
 }
 
 /// 2^32, the scale of the clamped-energy accumulator (which saturates at
