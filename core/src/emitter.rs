@@ -278,7 +278,7 @@ fn spread_velocity(e: &Emitter, dim: usize, rng: &mut Stream) -> [f32; 3] {
         // A build without 3D has only 2D worlds: the 3D branch (and cbrtf)
         // is not linked into it.
         let (dir, radius) = if dim == 2 || !cfg!(feature = "dim3") {
-            (random_unit::<2>(rng), libm::sqrtf(rng.unit()))
+            (random_unit::<2>(rng), crate::vector::sqrt(rng.unit()))
         } else {
             (random_unit::<3>(rng), libm::cbrtf(rng.unit()))
         };

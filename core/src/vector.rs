@@ -47,9 +47,42 @@ pub(crate) fn saturating_u64(x: f32) -> u64 {
     if exponent >= 23 { mantissa << (exponent - 23) } else { mantissa >> (23 - exponent) }
 }
 
+/// The square root, correctly rounded as IEEE 754 asks and as
+/// `libm::sqrtf` gives it. On Arm cores with a hard-float unit (the
+/// `eabihf` targets: VFP, which has the instruction) one `vsqrt.f32`,
+/// where libm is a software routine of some 260 bytes and a 256-byte
+/// table; elsewhere libm's (an instruction too where libm has one).
+#[inline(always)]
+pub(crate) fn sqrt(x: f32) -> f32 {
+    #[cfg(all(target_arch = "arm", target_abi = "eabihf"))]
+    {
+        let root: u32;
+        // Through s0, saved and restored around it: Rust names the FPU's
+        // registers in `asm!` only for double-precision units, and the
+        // Cortex-M4F's is single-precision.
+        // SAFETY: the instructions touch s0 (restored), the stack (balanced)
+        // and nothing else; hard-float code has the FPU on.
+        unsafe {
+            core::arch::asm!(
+                "vpush {{s0}}",
+                "vmov s0, {x}",
+                "vsqrt.f32 s0, s0",
+                "vmov {root}, s0",
+                "vpop {{s0}}",
+                x = in(reg) x.to_bits(),
+                root = lateout(reg) root,
+                options(pure, nomem, preserves_flags),
+            )
+        };
+        f32::from_bits(root)
+    }
+    #[cfg(not(all(target_arch = "arm", target_abi = "eabihf")))]
+    libm::sqrtf(x)
+}
+
 /// `v / |v|`, or `None` where the length is zero or not finite.
 pub(crate) fn normalise(v: [f32; 3]) -> Option<[f32; 3]> {
-    let len = libm::sqrtf(dot(v, v));
+    let len = sqrt(dot(v, v));
     (len.is_finite() && len > 1e-6).then(|| [v[0] / len, v[1] / len, v[2] / len])
 }
 
@@ -110,7 +143,7 @@ pub(crate) fn clamp_long(mut v: [f32; 3], s2: f32, limit: f32) -> ([f32; 3], f32
         }
         return (*v, f32::INFINITY);
     }
-    let scale = limit / libm::sqrtf(s2);
+    let scale = limit / sqrt(s2);
     for c in v.iter_mut() {
         *c *= scale;
     }
