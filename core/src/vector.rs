@@ -237,8 +237,8 @@ mod tests {
         for e in 0..256u32 {
             for k in 0..4 {
                 for sign in [0, 0x8000_0000] {
-                    check(f32::from_bits(sign | (e << 23) + k));
-                    check(f32::from_bits(sign | ((e << 23) | 0x7f_ffff) - k));
+                    check(f32::from_bits(sign | ((e << 23) + k)));
+                    check(f32::from_bits(sign | (((e << 23) | 0x7f_ffff) - k)));
                 }
             }
         }
