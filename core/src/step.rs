@@ -174,9 +174,16 @@ impl World {
         // Read by the potential's gradient alone, which only `fields` has.
         let periodic = if cfg!(feature = "fields") { self.periodic() } else { [false; 3] };
         let dim = self.dim();
+        // Without `small-step` the blocks read a copy of the description
+        // (`StepDescription`), taken here, before the header is borrowed:
+        // a copy made through the borrow would be a `memmove` (the
+        // compiler cannot tell that the two do not overlap), a routine of
+        // 1.3 KB on a small core.
+        #[cfg(not(feature = "small-step"))]
+        let copy = self.head.desc;
         let (head, p) = self.planes::<u8>();
-        // The description (`StepDescription`) and the counters, borrowed
-        // from the header together.
+        // The description and the counters, borrowed from the header
+        // together.
         let (desc, counters) = (&head.desc, &mut head.counters);
         let Layout { n, .. } = head.layout;
         let Planes { occupancy, rows, words, obstacle, velocity, mass_index, life, field, potential, wind, mass_table, surface, .. } = p;
@@ -200,7 +207,7 @@ impl World {
             #[cfg(feature = "small-step")]
             desc,
             #[cfg(not(feature = "small-step"))]
-            desc: *desc,
+            desc: copy,
             n,
             part,
             key: StepKey::blocks(desc.seed, head.step),
