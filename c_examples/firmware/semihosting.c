@@ -37,13 +37,21 @@ void sh_str(sh_line *line, const char *text) {
 }
 
 void sh_dec(sh_line *line, uint32_t value) {
-    char digits[10];
-    int n = 0;
-    do {
-        digits[n++] = (char)('0' + value % 10);
-        value /= 10;
-    } while (value != 0);
-    while (n > 0) put(line, digits[--n]);
+    /* Digit by digit from the highest power of ten, each by subtraction:
+     * no division, which the Cortex-M0 has no instruction for (it would
+     * link a division routine for this alone). */
+    static const uint32_t powers[] = {1000000000u, 100000000u, 10000000u, 1000000u, 100000u, 10000u, 1000u, 100u, 10u, 1u};
+    int started = 0;
+    for (size_t i = 0; i < sizeof powers / sizeof powers[0]; i++) {
+        char digit = '0';
+        while (value >= powers[i]) {
+            value -= powers[i];
+            digit++;
+        }
+        /* Leading zeros left out; 0 itself is one digit. */
+        started |= digit != '0' || powers[i] == 1;
+        if (started) put(line, digit);
+    }
 }
 
 void sh_hex64(sh_line *line, uint64_t value) {

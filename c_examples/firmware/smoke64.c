@@ -73,7 +73,9 @@ int main(void) {
     }
     mpca_world *w = NULL;
     CHECK(mpca_world_init(&d, world_memory, sizeof world_memory, &w));
-    const mpca_emitter e = {
+    /* Static: read where it lies in flash, not copied to the stack first
+     * (a copy is a memcpy call). */
+    static const mpca_emitter e = {
         .struct_size = sizeof e,
         .min = {30, 0, 0},
         .max = {34, 1, 1},

@@ -97,7 +97,7 @@ pub(crate) fn random_unit<const D: usize>(rng: &mut Stream) -> [f32; 3] {
         let v = [coord(xy & 0xffff), coord(xy >> 16), z];
         let r2 = dot_of::<D>(v, v);
         if r2 > 1.0 / 64.0 && r2 <= 1.0 {
-            let inv = 1.0 / libm::sqrtf(r2);
+            let inv = 1.0 / crate::vector::sqrt(r2);
             return v.map(|c| c * inv);
         }
     }
@@ -125,7 +125,7 @@ pub(crate) fn shares(ma: f32, mb: f32) -> (f32, f32) {
 #[inline]
 pub(crate) fn collide_pair<const D: usize>(va: [f32; 3], vb: [f32; 3], (sa, sb): (f32, f32), e: f32, r: [f32; 3]) -> ([f32; 3], [f32; 3]) {
     let rel = [va[0] - vb[0], va[1] - vb[1], va[2] - vb[2]];
-    let speed = e * libm::sqrtf(dot_of::<D>(rel, rel));
+    let speed = e * crate::vector::sqrt(dot_of::<D>(rel, rel));
     let mut a = [0.0; 3];
     let mut b = [0.0; 3];
     for k in 0..D {
@@ -186,7 +186,7 @@ pub(crate) fn energy_neutral<const D: usize>(a: [f32; 3], b: [f32; 3], (sa, sb):
     let rel = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
     let kinetic = sa * sb * dot_of::<D>(rel, rel);
     let lost = sa * gain(a) + sb * gain(b);
-    let l = if kinetic > lost { libm::sqrtf(1.0 - lost / kinetic) } else { 0.0 };
+    let l = if kinetic > lost { crate::vector::sqrt(1.0 - lost / kinetic) } else { 0.0 };
     let mut out = (a, b);
     for k in 0..D {
         let v0 = sa * a[k] + sb * b[k];

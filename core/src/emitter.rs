@@ -10,7 +10,7 @@ use crate::collision::random_unit;
 use crate::desc::finite;
 use crate::rng::{StepKey, Stream};
 use crate::vector::clamp;
-use crate::layout::Plain;
+use crate::layout::{view_counted_ref, Plain};
 use crate::world::World;
 use crate::Error;
 
@@ -51,10 +51,11 @@ unsafe impl Plain for Slot {}
 /// `lifetimes`, an age plane stores it (2D drops the third axis), or why
 /// such a world refuses it. Shared by [`World::add_emitter`] and the
 /// snapshot loader (M12), which holds a stored emitter to the same rules.
-pub(crate) fn checked(e: Emitter, dim: usize, n: [usize; 3], lifetimes: bool) -> Result<Emitter, Error> {
+/// `e` is changed in place, refused or not (no copy of it in or out, each
+/// a `memcpy` call on a small core): callers check a copy of their own.
+pub(crate) fn checked(e: &mut Emitter, dim: usize, n: [usize; 3], lifetimes: bool) -> Result<(), Error> {
     // Every float is checked as given, before 2D drops the third axis.
     finite(&[e.rate, e.velocity[0], e.velocity[1], e.velocity[2], e.spread])?;
-    let mut e = e;
     if dim == 2 {
         e.min[2] = 0;
         e.max[2] = 1;
@@ -72,7 +73,7 @@ pub(crate) fn checked(e: Emitter, dim: usize, n: [usize; 3], lifetimes: bool) ->
     if e.lifetime > 0 && !lifetimes {
         return Err(Error::NotEnabled);
     }
-    Ok(e)
+    Ok(())
 }
 
 /// Whether `|v| + spread > 1`, decided exactly, for finite `v` and
@@ -164,10 +165,12 @@ impl Wide {
 
 impl World {
     /// Adds an emitter and returns its index.
-    pub fn add_emitter(&mut self, e: Emitter) -> Result<usize, Error> {
-        let e = checked(e, self.dim(), self.layout().n, self.head.desc.lifetimes)?;
+    pub fn add_emitter(&mut self, mut e: Emitter) -> Result<usize, Error> {
+        checked(&mut e, self.dim(), self.layout().n, self.head.desc.lifetimes)?;
         let used = self.head.emitters as usize;
-        if used >= self.layout().emitters.len / core::mem::size_of::<Slot>() {
+        // The capacity the plane was sized for (`Layout::of`), without a
+        // division by the slot's size.
+        if used >= self.head.desc.emitter_capacity as usize {
             return Err(Error::EmitterTableFull);
         }
         let mass_index = u32::from(self.mass_index_of(e.mass)?);
@@ -190,25 +193,32 @@ impl World {
         Ok(())
     }
 
+    /// The emitter table, as long as its capacity.
+    fn slots(&self) -> &[Slot] {
+        view_counted_ref(self.plane_bytes(self.layout().emitters), self.head.desc.emitter_capacity as usize)
+    }
+
     /// Runs every emitter once (M6), at the start of a step.
     pub(crate) fn emit(&mut self) {
         let (seed, step, dim) = (self.head.desc.seed, self.head.step, self.dim());
         let key = StepKey::emitters(seed, step);
         for i in 0..self.head.emitters as usize {
-            let slot: Slot = self.plane::<Slot>(self.layout().emitters)[i];
+            let slot: Slot = self.slots()[i];
             let e = slot.emitter;
             let mut rng = key.stream(i as u64);
-            let whole = libm::floorf(e.rate);
+            let whole = whole_part(e.rate);
             // Casting saturates, so an absurd rate asks for u64::MAX.
-            let wanted = (whole as u64).saturating_add(u64::from(rng.chance(e.rate - whole)));
+            let wanted = crate::vector::saturating_u64(whole).saturating_add(u64::from(rng.chance(e.rate - whole)));
             if wanted == 0 {
                 continue;
             }
-            let l = *self.layout();
-            let mut free = 0u64;
-            each_site(&l, &e, |s| free += u64::from(!self.occupied(s) && !self.is_obstacle(s)));
-            let placing = wanted.min(free);
-            self.head.counters.shortfall = self.head.counters.shortfall.saturating_add(wanted - placing);
+            let grid = self.layout().grid();
+            // Cells, counted in machine words (not u64: small cores add
+            // those in pairs of instructions).
+            let mut free = 0usize;
+            each_site(grid, &e, |s| free += usize::from(!self.occupied(s) && !self.is_obstacle(s)));
+            let placing = wanted.min(free as u64) as usize;
+            self.head.counters.shortfall = self.head.counters.shortfall.saturating_add(wanted - placing as u64);
             let mut need = placing;
             let mut left = free;
             let mut chosen = |w: &mut World, s| {
@@ -218,7 +228,7 @@ impl World {
                 // Selection sampling: take this cell with chance need/left,
                 // which picks a uniform subset of `placing` free cells.
                 // `left` counts cells, so it fits the u32 of `below`.
-                let take = u64::from(rng.below(left as u32)) < need;
+                let take = (rng.below(left as u32) as usize) < need;
                 left -= 1;
                 if take {
                     need -= 1;
@@ -226,16 +236,31 @@ impl World {
                     w.place_emitted(s, v, slot.mass_index as u8, e.lifetime as u16, &mut rng);
                 }
             };
-            each_site(&l, &e, |s| chosen(self, s));
+            each_site(grid, &e, |s| chosen(self, s));
             // Saturating: an image (M12) may carry any count.
-            self.head.counters.emitted = self.head.counters.emitted.saturating_add(placing);
-            self.head.counters.particles += placing;
+            self.head.counters.emitted = self.head.counters.emitted.saturating_add(placing as u64);
+            self.head.counters.particles += placing as u64;
         }
     }
 }
 
+/// `floor(x)` for an `x` that is not negative (a rate: `checked`), by
+/// clearing the bits of its fraction: a few instructions where `floorf`
+/// is a library routine of some 100 bytes.
+fn whole_part(x: f32) -> f32 {
+    let bits = x.to_bits();
+    let exponent = (bits >> 23 & 0xff) as i32 - 127;
+    if exponent < 0 {
+        // Below 1: no whole part (the sign kept, as floor keeps -0).
+        return f32::from_bits(bits & 0x8000_0000);
+    }
+    // 23 fraction bits, of which `exponent` lie above the point.
+    let fraction = 0x7f_ffffu32.checked_shr(exponent as u32).unwrap_or(0);
+    f32::from_bits(bits & !fraction)
+}
+
 /// Calls `f` with every site of the emitter's region.
-fn each_site(l: &crate::layout::Layout, e: &Emitter, mut f: impl FnMut(crate::layout::Site)) {
+fn each_site(l: crate::layout::Grid, e: &Emitter, mut f: impl FnMut(crate::layout::Site)) {
     for z in e.min[2] as usize..e.max[2] as usize {
         for y in e.min[1] as usize..e.max[1] as usize {
             for x in e.min[0] as usize..e.max[0] as usize {
@@ -253,7 +278,7 @@ fn spread_velocity(e: &Emitter, dim: usize, rng: &mut Stream) -> [f32; 3] {
         // A build without 3D has only 2D worlds: the 3D branch (and cbrtf)
         // is not linked into it.
         let (dir, radius) = if dim == 2 || !cfg!(feature = "dim3") {
-            (random_unit::<2>(rng), libm::sqrtf(rng.unit()))
+            (random_unit::<2>(rng), crate::vector::sqrt(rng.unit()))
         } else {
             (random_unit::<3>(rng), libm::cbrtf(rng.unit()))
         };
@@ -287,6 +312,27 @@ mod tests {
 
     fn down(x: f32) -> f32 {
         f32::from_bits(x.to_bits() - 1)
+    }
+
+    #[test]
+    fn whole_part_is_floor_for_rates() {
+        // Expect: floorf's value, bit for bit, for 0, -0, every power of
+        // two's neighbours, infinity and random values of every size.
+        let mut rng = block_stream(9, 9, 9);
+        let check = |x: f32| assert_eq!(whole_part(x).to_bits(), libm::floorf(x).to_bits(), "{x:e}");
+        check(0.0);
+        check(-0.0);
+        check(f32::INFINITY);
+        for e in 0..255u32 {
+            let x = f32::from_bits(e << 23);
+            for k in 0..3 {
+                check(f32::from_bits(x.to_bits() + k));
+                check(f32::from_bits((x.to_bits() + k).saturating_sub(3)));
+            }
+        }
+        for _ in 0..crate::sized(100_000, 1_000) {
+            check(f32::from_bits(rng.bits(31)));
+        }
     }
 
     #[test]

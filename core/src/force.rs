@@ -123,7 +123,8 @@ impl Flow<'_> {
 pub(crate) fn vortex_force(v: &Vortex, p: [f32; 2]) -> [f32; 2] {
     let dx = p[0] - v.centre[0];
     let dy = p[1] - v.centre[1];
-    let r2 = (dx * dx + dy * dy).max(v.core_radius * v.core_radius);
+    // Neither is NaN: squares of finite numbers (Layout::of, set_vortex).
+    let r2 = crate::vector::larger(dx * dx + dy * dy, v.core_radius * v.core_radius);
     let s = v.circulation / (core::f32::consts::TAU * r2);
     let along = |d: f32| if d == 0.0 { 0.0 } else { d * s };
     [-along(dy), along(dx)]

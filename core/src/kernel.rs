@@ -52,9 +52,18 @@ use crate::vector::{clamp_long, dot, dot_of, normalise};
 use crate::layout::{mark, put_bit};
 use crate::world::{Counters, ENERGY_SCALE};
 
+/// The description as a step's blocks read it: with `small-step` where it
+/// lies in the world's header (no copy to set up: less flash, a load more
+/// for each field a block reads), otherwise a copy beside the other
+/// shared data, which the lean routines read without that load.
+#[cfg(feature = "small-step")]
+pub(crate) type StepDescription<'a> = &'a Description;
+#[cfg(not(feature = "small-step"))]
+pub(crate) type StepDescription<'a> = Description;
+
 /// What every block of a step reads and none writes.
 pub(crate) struct Shared<'a> {
-    pub desc: Description,
+    pub desc: StepDescription<'a>,
     pub n: [usize; 3],
     pub part: Partition,
     pub key: StepKey,
@@ -300,8 +309,8 @@ fn read_block<const CELLS: usize>(plane: &[u64], row: &BlockRow, xs: [usize; 2])
 /// A unit normal from cell `to` back towards cell `from` of the same block.
 pub(crate) fn back_normal<const D: usize>(from: usize, to: usize) -> [f32; 3] {
     let mut n = [0.0f32; 3];
-    for (k, nk) in n.iter_mut().enumerate().take(D) {
-        *nk = ((from >> k) & 1) as f32 - ((to >> k) & 1) as f32;
+    for k in 0..D {
+        n[k] = ((from >> k) & 1) as f32 - ((to >> k) & 1) as f32;
     }
     normalise(n).unwrap_or([0.0; 3])
 }
@@ -334,7 +343,7 @@ fn clamp_and_count(x: [f32; 3], s2: f32, scale: f32, m: f32, counters: &mut Coun
     counters.clamps += 1;
     // f32 and a saturating cast: no f64 or 128-bit arithmetic, which small
     // cores emulate; f32's 24 bits are far finer than the statistic needs.
-    let fixed = (0.5 * m * (s2 - 1.0) * ENERGY_SCALE as f32) as u64;
+    let fixed = crate::vector::saturating_u64(0.5 * m * (s2 - 1.0) * ENERGY_SCALE as f32);
     counters.clamp_energy = counters.clamp_energy.saturating_add(fixed);
     x
 }
@@ -493,6 +502,17 @@ fn contacts<const D: usize, const CELLS: usize>(
     }
 }
 
+/// Stored components as integers (quanta), component by component: an
+/// array's `map` is a call at opt-level z.
+#[inline(always)]
+fn ints<Q: Quant, const D: usize>(q: [Q; D]) -> [i32; D] {
+    let mut v = [0; D];
+    for k in 0..D {
+        v[k] = q[k].to_int();
+    }
+    v
+}
+
 /// A block's particles as the stages of M5 see them.
 struct Block<const D: usize, const CELLS: usize> {
     /// Cells holding a particle.
@@ -564,18 +584,19 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
     fn load(&self, row: &BlockRow, xs: [usize; 2], occ: u8) -> Block<D, CELLS> {
         let mut b = Block { occ, v: [[0; D]; CELLS], pending: 0, x: [[0.0; 3]; CELLS], dirty: 0 };
         let velocity = self.planes.velocity;
-        if xs[1] == xs[0] + 1 {
+        // With `small-step` a cell at a time always: one loop, less flash.
+        if !cfg!(feature = "small-step") && xs[1] == xs[0] + 1 {
             for r in 0..CELLS / 2 {
                 if occ >> (2 * r) & 3 != 0 {
                     let at = xs[0] + row.cell[r];
                     let pair = velocity.pair(at);
-                    b.v[2 * r] = pair[0].map(Q::to_int);
-                    b.v[2 * r + 1] = pair[1].map(Q::to_int);
+                    b.v[2 * r] = ints(pair[0]);
+                    b.v[2 * r + 1] = ints(pair[1]);
                 }
             }
         } else {
             for c in cells_of(occ) {
-                b.v[c] = velocity.get(xs[c & 1] + row.cell[c >> 1]).map(Q::to_int);
+                b.v[c] = ints(velocity.get(xs[c & 1] + row.cell[c >> 1]));
             }
         }
         b
@@ -982,8 +1003,8 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
         let at = |c: usize| [x0 as i64 + (c & 1) as i64, row.origin[0] as i64 + ((c >> 1) & 1) as i64, row.origin[1] as i64 + ((c >> 2) & 1) as i64];
         let mut outside = row.outside;
         if x_out != 0 {
-            let low = if x_out & 1 != 0 { cells_at(0, 0, D) } else { 0 };
-            outside |= low | if x_out & 2 != 0 { cells_at(0, 1, D) } else { 0 };
+            let low = if x_out & 1 != 0 { const { cells_at(0, 0, D) } } else { 0 };
+            outside |= low | if x_out & 2 != 0 { const { cells_at(0, 1, D) } } else { 0 };
         }
         // The cells beyond a face are wall or open (their sites mean
         // nothing).
@@ -1009,6 +1030,9 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
                 life[c] = self.planes.life.get(cell(c));
             }
         }
+        // A cell's mass: the world's one where particles carry none (no
+        // array read, so no bounds check, in a build without masses).
+        let mass_of = |c: usize| if desc.has_masses() { mass[c] } else { desc.mass };
         let mut rng = sh.key.stream(row.index + bx as u64);
         let mut bytes = None;
 
@@ -1018,15 +1042,20 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
                 let pos = sh.part.cell_coords(row, [xs[c & 1], 0, 0], c);
                 // dt = 0 changes nothing, even under an infinite force
                 // (0 * inf would be NaN).
-                let a = sh.terms.accel(pos, cell(c), mass[c]);
-                a.map(|a| if sh.dt_q == 0.0 { 0.0 } else { a * sh.dt_q })
+                let mut a = sh.terms.accel(pos, cell(c), mass_of(c));
+                // Component by component: an array's map is a call at
+                // opt-level z.
+                for a in &mut a {
+                    *a = if sh.dt_q == 0.0 { 0.0 } else { *a * sh.dt_q };
+                }
+                a
             } else {
                 sh.push.unwrap_or_default()
             };
             // A force that changes nothing is no step 1: a zero-valued part
             // gives the same world as a world without it (M9).
             if dv != [0.0; 3] {
-                self.push(&mut b, c, dv, mass[c]);
+                self.push(&mut b, c, dv, mass_of(c));
             }
         }
 
@@ -1041,14 +1070,14 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
                 for k in 0..D {
                     x[k] = (x[k] + a * u[k]) / (1.0 + a);
                 }
-                clamp_counted::<D>(&mut x, Q::SCALE, mass[c], &mut self.counters);
+                clamp_counted::<D>(&mut x, Q::SCALE, mass_of(c), &mut self.counters);
                 b.set(c, x);
             }
         }
 
         // M5.2 collision, then M1 for what the force, the drag and the
         // collision changed.
-        self.collide(&mut b, &mut rng, |c| mass[c], !desc.has_masses());
+        self.collide(&mut b, &mut rng, mass_of, !desc.has_masses());
         b.round::<Q>(&mut rng);
 
         // M5.3 desired move, M5.4 obstacle reflection: `want[c]` holds the
@@ -1062,7 +1091,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
             if m != 0 && blocked >> t & 1 != 0 {
                 let to = Wanted { cell: t, site: cell(t), at: at(t), wall: wall >> t & 1 != 0 };
                 // M5.4, its new velocity rounded at once (M1).
-                if let Some(x) = reflect_off::<D>(sh, b.velocity(c), c, to, mass[c], Q::SCALE, &mut self.counters) {
+                if let Some(x) = reflect_off::<D>(sh, b.velocity(c), c, to, mass_of(c), Q::SCALE, &mut self.counters) {
                     b.set(c, x);
                     b.round_apart::<Q>(&mut rng);
                 }

@@ -60,6 +60,40 @@ pub(crate) fn view_ref<T: Plain>(bytes: &[u8]) -> &[T] {
     unsafe { core::slice::from_raw_parts(bytes.as_ptr().cast::<T>(), bytes.len() / size_of::<T>()) }
 }
 
+/// `bytes` as values of `T`, whose plane [`Layout::of`] sized for `count`
+/// of them (the emitters: a structure of 56 bytes). With `small-step`
+/// (firmware) the first `count` (none where fewer fit), without the
+/// division by the size that [`view`] makes, which small cores call a
+/// routine for; otherwise [`view`], the same values.
+#[inline]
+pub(crate) fn view_counted<T: Plain>(bytes: &mut [u8], count: usize) -> &mut [T] {
+    if !cfg!(feature = "small-step") {
+        return view(bytes);
+    }
+    let count = if fits::<T>(bytes.len(), count) { count } else { 0 };
+    debug_assert_eq!(bytes.as_ptr() as usize % align_of::<T>(), 0);
+    // SAFETY: as in `view`, for `count` values of T, which fit in `bytes`.
+    unsafe { core::slice::from_raw_parts_mut(bytes.as_mut_ptr().cast::<T>(), count) }
+}
+
+/// Read-only twin of [`view_counted`].
+#[inline]
+pub(crate) fn view_counted_ref<T: Plain>(bytes: &[u8], count: usize) -> &[T] {
+    if !cfg!(feature = "small-step") {
+        return view_ref(bytes);
+    }
+    let count = if fits::<T>(bytes.len(), count) { count } else { 0 };
+    debug_assert_eq!(bytes.as_ptr() as usize % align_of::<T>(), 0);
+    // SAFETY: as in `view_counted`.
+    unsafe { core::slice::from_raw_parts(bytes.as_ptr().cast::<T>(), count) }
+}
+
+/// Whether `count` values of `T` fit in `len` bytes.
+#[inline]
+fn fits<T>(len: usize, count: usize) -> bool {
+    count.checked_mul(size_of::<T>()).is_some_and(|n| n <= len)
+}
+
 /// Where one plane lies in the world's memory, in bytes from its start.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub(crate) struct Plane {
@@ -174,44 +208,52 @@ impl Layout {
         }
 
         // Cell indices are stored as u32 (surface table), so the cell count
-        // must fit one; every byte count below is checked against usize.
-        let cells = n[0].checked_mul(n[1]).and_then(|c| c.checked_mul(n[2])).ok_or(Error::TooLarge)?;
+        // must fit one; every byte count below is checked against usize,
+        // and any that overflows is the one error TooLarge.
+        let cells = mul(mul(n[0], n[1])?, n[2])?;
         if u32::try_from(cells).is_err() {
             return Err(Error::TooLarge);
         }
+        let rows = n[1] * n[2];
         let row_words = row_words(n[0]);
-        let bit_plane = row_words.checked_mul(n[1] * n[2]).and_then(|w| w.checked_mul(8)).ok_or(Error::TooLarge)?;
+        let bit_plane = mul(mul(row_words, rows)?, 8)?;
         // Bit planes are indexed by bit, so their bit count must fit too.
-        bit_plane.checked_mul(8).ok_or(Error::TooLarge)?;
+        mul(bit_plane, 8)?;
         let q = match d.quantization {
             Quantization::Bits8 => 1,
             Quantization::Bits16 => 2,
         };
-        let per_cell = |bytes: usize, on: bool| -> Result<usize, Error> {
-            if on { cells.checked_mul(bytes).ok_or(Error::TooLarge) } else { Ok(0) }
-        };
-        let mut b = Builder { at: 0 };
-        let occupancy = b.plane(bit_plane)?;
-        let rows = b.plane(n[1] * n[2])?;
+        // `bytes` a cell where `on`.
+        let per_cell = |bytes: usize, on: bool| mul(cells, bytes * usize::from(on));
         let summary_words = row_words.div_ceil(64);
-        let words = b.plane(summary_words * n[1] * n[2] * 8)?;
-        let obstacle = b.plane(if d.obstacles { bit_plane } else { 0 })?;
-        let velocity = b.plane(per_cell(dim * q, true)?)?;
-        let mass_index = b.plane(per_cell(1, d.per_particle_mass)?)?;
-        let life = b.plane(per_cell(2, d.lifetimes)?)?;
-        let field = b.plane(per_cell(dim * 4, d.forces.field)?)?;
-        let potential = b.plane(per_cell(4, d.forces.potential)?)?;
-        let wind = b.plane(per_cell(dim * 4, d.drag.field)?)?;
-        let mass_table = b.plane(if d.per_particle_mass { d.mass_classes as usize * 4 } else { 0 })?;
-        let surface_len = if d.obstacles {
-            (d.surface_capacity as usize).checked_mul(core::mem::size_of::<crate::obstacle::Surface>()).ok_or(Error::TooLarge)?
-        } else {
-            0
-        };
-        let surface = b.plane(surface_len)?;
-        let emitters = b.plane(
-            (d.emitter_capacity as usize).checked_mul(core::mem::size_of::<crate::emitter::Slot>()).ok_or(Error::TooLarge)?,
-        )?;
+        // The planes' lengths in the order they lie in memory, each
+        // starting 8-byte aligned after the one before.
+        let lens = [
+            bit_plane,
+            rows,
+            summary_words * rows * 8,
+            bit_plane * usize::from(d.obstacles),
+            per_cell(dim * q, true)?,
+            per_cell(1, d.per_particle_mass)?,
+            per_cell(2, d.lifetimes)?,
+            per_cell(dim * 4, d.forces.field)?,
+            per_cell(4, d.forces.potential)?,
+            per_cell(dim * 4, d.drag.field)?,
+            if d.per_particle_mass { d.mass_classes as usize * 4 } else { 0 },
+            mul(d.surface_capacity as usize * usize::from(d.obstacles), size_of::<crate::obstacle::Surface>())?,
+            mul(d.emitter_capacity as usize, size_of::<crate::emitter::Slot>())?,
+        ];
+        let mut planes = [Plane::default(); 13];
+        let mut at = 0usize;
+        for (plane, len) in planes.iter_mut().zip(lens) {
+            *plane = Plane { off: at, len };
+            at = at.checked_add(len).and_then(|e| e.checked_add(7)).ok_or(Error::TooLarge)? & !7;
+            // Slices may not exceed isize::MAX bytes.
+            if at > isize::MAX as usize / 2 {
+                return Err(Error::TooLarge);
+            }
+        }
+        let [occupancy, rows, words, obstacle, velocity, mass_index, life, field, potential, wind, mass_table, surface, emitters] = planes;
         Ok(Layout {
             n,
             cells,
@@ -230,26 +272,16 @@ impl Layout {
             mass_table,
             surface,
             emitters,
-            total: b.at,
+            total: at,
         })
     }
 }
 
-struct Builder {
-    at: usize,
-}
-
-impl Builder {
-    fn plane(&mut self, len: usize) -> Result<Plane, Error> {
-        let off = self.at;
-        let end = off.checked_add(len).and_then(|e| e.checked_add(7)).ok_or(Error::TooLarge)? & !7;
-        // Slices may not exceed isize::MAX bytes.
-        if end > isize::MAX as usize / 2 {
-            return Err(Error::TooLarge);
-        }
-        self.at = end;
-        Ok(Plane { off, len })
-    }
+/// `a * b`, or `TooLarge` where it overflows. Out of line: one copy for
+/// every size [`Layout::of`] checks.
+#[inline(never)]
+fn mul(a: usize, b: usize) -> Result<usize, Error> {
+    a.checked_mul(b).ok_or(Error::TooLarge)
 }
 
 /// Mutable views of every plane, borrowed together.
@@ -285,8 +317,14 @@ pub(crate) struct Site {
 /// Notes that cell `x` of row `row` now holds a particle: sets the row's
 /// flag and its summary bit for the occupancy word holding the cell, so the
 /// step does not skip them (M3). `summary_words` words per row.
+///
+/// With `small-step` nothing: that build's sweep reads neither
+/// ([`crate::partition::Partition::sweep_band`]).
 #[inline]
 pub(crate) fn mark(rows: Cells<'_, u8>, words: Cells<'_, u64>, summary_words: usize, row: usize, x: usize) {
+    if cfg!(feature = "small-step") {
+        return;
+    }
     rows.set(row, 1);
     let w = x >> 6;
     let at = row * summary_words + (w >> 6);
@@ -316,6 +354,28 @@ pub(crate) fn put_bit(plane: Cells<'_, u64>, bit: usize, on: bool) {
 }
 
 impl Layout {
+    /// The site of in-range coordinates.
+    #[inline]
+    pub(crate) fn site(&self, x: usize, y: usize, z: usize) -> Site {
+        self.grid().site(x, y, z)
+    }
+
+    /// What [`Layout::site`] reads, apart: a copy of three words where a
+    /// caller must let go of the world (the emitters' placement).
+    #[inline]
+    pub(crate) fn grid(&self) -> Grid {
+        Grid { n: self.n, row_words: self.row_words }
+    }
+}
+
+/// The cells per axis and the words per bit-plane row of a [`Layout`].
+#[derive(Clone, Copy)]
+pub(crate) struct Grid {
+    n: [usize; 3],
+    row_words: usize,
+}
+
+impl Grid {
     /// The site of in-range coordinates.
     #[inline]
     pub(crate) fn site(&self, x: usize, y: usize, z: usize) -> Site {

@@ -245,6 +245,9 @@ impl Partition {
     /// The flags and summaries of rows outside the band are neither read
     /// nor written, so bands can be swept at the same time (M11).
     pub fn sweep_band<'a, S: BlockSink<'a>>(&self, sink: &mut S, band: Range<usize>, reverse: bool, skip: bool) {
+        if cfg!(feature = "small-step") {
+            return self.sweep_band_small(sink, band, reverse);
+        }
         let idx = sink.index();
         let [ax, ay, az] = self.axes;
         let dim = S::DIM;
@@ -254,7 +257,11 @@ impl Partition {
         let mut j = 0;
         while j < total {
             let i = if reverse { band.end - 1 - j } else { band.start + j };
-            let (by, bz) = (i % ay.blocks, i / ay.blocks);
+            // In 2D the grid has one layer of rows of blocks (`az.blocks`
+            // is 1). With `small-step` (firmware) no division for it, which
+            // small cores call a routine for; otherwise the remainder tells
+            // the compiler `by < ay.blocks`, which spares checks below.
+            let (by, bz) = if dim == 2 && cfg!(feature = "small-step") { (i, 0) } else { (i % ay.blocks, i / ay.blocks) };
             let origin = [ay.first + 2 * by as isize, az.first + 2 * bz as isize];
             let (ys, y_out) = self.axis_pair(1, origin[0]);
             let (zs, z_out) = self.axis_pair(2, origin[1]);
@@ -264,7 +271,10 @@ impl Partition {
             for dz in 0..layers {
                 for dy in 0..2 {
                     if (y_out >> dy | z_out >> dz) & 1 != 0 {
-                        outside |= cells_at(1, dy, dim) & cells_at(2, dz, dim);
+                        // The masks as constants (no call at opt-level z).
+                        let y = if dy == 0 { const { cells_at(1, 0, S::DIM) } } else { const { cells_at(1, 1, S::DIM) } };
+                        let z = if dz == 0 { const { cells_at(2, 0, S::DIM) } } else { const { cells_at(2, 1, S::DIM) } };
+                        outside |= y & z;
                         continue;
                     }
                     let l = ys[dy] + ay.n * zs[dz];
@@ -293,6 +303,93 @@ impl Partition {
                 _ => self.empty_run::<2>(idx.rows, [by, bz], reverse, room),
             }
             .max(1);
+        }
+    }
+
+    /// [`Partition::sweep_band`] with `small-step`: the rows of blocks in
+    /// the band, and in each the blocks holding a particle, found from the
+    /// set bits of the OR of the row's domain rows, a word at a time, and
+    /// visited in the same order. The row flags and summary words are
+    /// neither read nor kept: only the sweep without `small-step` reads
+    /// them, to skip what they say is empty, and the blocks and the edits
+    /// only ever set them. Much less code; a word read for every word of
+    /// every row.
+    fn sweep_band_small<'a, S: BlockSink<'a>>(&self, sink: &mut S, band: Range<usize>, reverse: bool) {
+        let occupancy = sink.index().occupancy;
+        // By reference: a copy of the axes is a memcpy call at opt-level z.
+        let [ax, ay, az] = &self.axes;
+        // Offset 1 on a periodic x axis: the last block holds cells n - 1
+        // and 0; bit 0 of a row is that block's, not block 0's.
+        let wraps = ax.first == 1;
+        let last = ax.blocks - 1;
+        for j in 0..band.len() {
+            let i = if reverse { band.end - 1 - j } else { band.start + j };
+            // In 2D one layer of rows of blocks: no division.
+            let (by, bz) = if S::DIM == 2 { (i, 0) } else { (i % ay.blocks, i / ay.blocks) };
+            let origin = [ay.first + 2 * by as isize, az.first + 2 * bz as isize];
+            let (ys, y_out) = self.axis_pair(1, origin[0]);
+            let (zs, z_out) = self.axis_pair(2, origin[1]);
+            let mut row = BlockRow { word: [0; 4], cell: [0; 4], line: [0; 4], outside: 0, origin, index: (i * ax.blocks) as u64 };
+            // Block row r holds cells 2r and 2r + 1, at y offset r & 1 and
+            // z offset r >> 1.
+            for r in 0..S::CELLS / 2 {
+                if (y_out >> (r & 1) | z_out >> (r >> 1)) & 1 != 0 {
+                    row.outside |= 3 << (2 * r);
+                    continue;
+                }
+                let l = ys[r & 1] + ay.n * zs[r >> 1];
+                (row.line[r], row.word[r], row.cell[r]) = (l, l * self.row_words, l * ax.n);
+            }
+            // Block bx, if it holds a particle: its occupancy read a cell
+            // at a time, now (the blocks before it changed only their own
+            // cells).
+            let mut visit = |bx: usize| {
+                let x0 = ax.first + 2 * bx as isize;
+                let (xs, x_out) = self.axis_pair(0, x0);
+                let mut occ = 0u8;
+                for c in 0..S::CELLS {
+                    if (row.outside | x_out << (c & !1)) >> c & 1 == 0 {
+                        let (x, word) = (xs[c & 1], row.word[c >> 1]);
+                        occ |= ((occupancy.get(word + (x >> 6)) >> (x & 63)) as u8 & 1) << c;
+                    }
+                }
+                if occ != 0 {
+                    sink.visit(&row, x0, bx, occ);
+                }
+            };
+            // The blocks of the set bits, each once: `next` is the first
+            // block not passed yet (forward) or the last (reverse, from
+            // one past the end).
+            let mut next = if reverse { ax.blocks } else { 0 };
+            if reverse && wraps {
+                visit(last);
+                next = last;
+            }
+            for jw in 0..self.row_words {
+                let w = if reverse { self.row_words - 1 - jw } else { jw };
+                let mut m = 0u64;
+                for r in 0..S::CELLS / 2 {
+                    if row.outside >> (2 * r) & 1 == 0 {
+                        m |= occupancy.get(row.word[r] + w);
+                    }
+                }
+                while m != 0 {
+                    let b = if reverse { 63 - m.leading_zeros() } else { m.trailing_zeros() } as usize;
+                    m &= !(1u64 << b);
+                    let x = 64 * w + b;
+                    if wraps && x == 0 {
+                        continue;
+                    }
+                    let bx = ((x as isize - ax.first) >> 1) as usize;
+                    if (!reverse && bx >= next) || (reverse && bx < next) {
+                        visit(bx);
+                        next = if reverse { bx } else { bx + 1 };
+                    }
+                }
+            }
+            if !reverse && wraps && next <= last {
+                visit(last);
+            }
         }
     }
 

@@ -147,7 +147,7 @@ impl World {
 
     /// The cells holding a particle, in cell order (x fastest).
     pub(crate) fn occupied_cells(&self) -> Occupied<'_> {
-        Occupied { layout: self.layout(), word: 0, bits: 0, words: self.plane::<u64>(self.layout().occupancy) }
+        Occupied { layout: self.layout(), words: self.plane::<u64>(self.layout().occupancy), word: 0, bits: 0, row: 0, row_start: 0 }
     }
 
     /// Fills `out` with the share of cells holding a particle in each of
@@ -325,26 +325,35 @@ impl Iterator for Particles<'_> {
 pub(crate) struct Occupied<'a> {
     layout: &'a Layout,
     words: &'a [u64],
+    /// The next word to read.
     word: usize,
     bits: u64,
+    /// The row `y + ny z` of the last word read, and the number of that
+    /// row's first word: counted on as words are read, with no division,
+    /// which small cores call a routine for.
+    row: usize,
+    row_start: usize,
 }
 
 impl Iterator for Occupied<'_> {
     type Item = ([u32; 3], usize);
 
     fn next(&mut self) -> Option<([u32; 3], usize)> {
+        let l = self.layout;
         while self.bits == 0 {
             let w = *self.words.get(self.word)?;
             self.bits = w;
+            if self.word - self.row_start == l.row_words {
+                self.row += 1;
+                self.row_start = self.word;
+            }
             self.word += 1;
         }
         let b = self.bits.trailing_zeros() as usize;
         self.bits &= self.bits - 1;
-        let l = self.layout;
-        let w = self.word - 1;
-        let row = w / l.row_words;
-        let x = (w % l.row_words) * 64 + b;
-        let (y, z) = (row % l.n[1], row / l.n[1]);
+        let x = (self.word - 1 - self.row_start) * 64 + b;
+        // A build without 3D has one layer: the row is y.
+        let (y, z) = if cfg!(feature = "dim3") { (self.row % l.n[1], self.row / l.n[1]) } else { (self.row, 0) };
         Some(([x as u32, y as u32, z as u32], l.site(x, y, z).cell))
     }
 }

@@ -134,7 +134,7 @@ impl Stream {
             // In 32 bits (2^width - n fits): no 64-bit division, which small
             // cores call a library routine for.
             let span = if width == 16 { 1u32 << 16 } else { 0 };
-            let threshold = u64::from(span.wrapping_sub(n) % n);
+            let threshold = u64::from(remainder(span.wrapping_sub(n), n));
             while low(m) < threshold {
                 m = u64::from(self.bits(width)) * u64::from(n);
             }
@@ -153,6 +153,28 @@ impl Stream {
     pub fn chance(&mut self, p: f32) -> bool {
         self.unit() < p
     }
+}
+
+/// `a % n` (`n >= 1`) by shifts and subtractions, a bit at a time: the
+/// rejection threshold of [`Stream::below`], which a draw needs once in
+/// thousands, without the division routine that small cores (Cortex-M0)
+/// would otherwise link for it: with `small-step` (firmware) only, since
+/// hosts divide in one instruction.
+fn remainder(a: u32, n: u32) -> u32 {
+    if !cfg!(feature = "small-step") {
+        return a % n;
+    }
+    // r < n before each step; doubled plus a bit it is below 2n, which
+    // may pass 2^32 (the bit shifted out): then it is n or more.
+    let mut r = 0u32;
+    for i in (0..32).rev() {
+        let carry = r >> 31;
+        r = r << 1 | (a >> i & 1);
+        if carry != 0 || r >= n {
+            r = r.wrapping_sub(n);
+        }
+    }
+    r
 }
 
 /// The stream of block `block` (its index in the step's block grid) at `step`.
@@ -208,6 +230,23 @@ mod tests {
         s.bits(16);
         s.bits(32);
         assert_eq!(u64::from(s.bits(24)), t.next_u64() & 0xff_ffff);
+    }
+
+    #[test]
+    fn remainder_is_the_remainder() {
+        // Expect: a % n for every edge of the u32 range and random pairs.
+        let mut rng = block_stream(5, 6, 7);
+        let edges = [1u32, 2, 3, 7, 1 << 16, (1 << 31) - 1, 1 << 31, (1 << 31) + 1, u32::MAX - 1, u32::MAX];
+        for &n in &edges {
+            for &a in edges.iter().chain(&[0]) {
+                assert_eq!(remainder(a, n), a % n, "{a} % {n}");
+            }
+        }
+        for _ in 0..crate::sized(10_000, 200) {
+            let (a, n) = (rng.bits(32), rng.bits(32) >> rng.bits(5));
+            let n = n.max(1);
+            assert_eq!(remainder(a, n), a % n, "{a} % {n}");
+        }
     }
 
     #[test]

@@ -608,7 +608,8 @@ fn check(img: &Image<'_>) -> Result<(), Error> {
     for b in img.emitter.chunks_exact(EMITTER) {
         let s = get_slot(b);
         let e = s.emitter;
-        if checked(e, dim, l.n, d.lifetimes) != Ok(e) {
+        let mut stored = e;
+        if checked(&mut stored, dim, l.n, d.lifetimes).is_err() || stored != e {
             return bad;
         }
         let class = s.mass_index as usize;

@@ -18,7 +18,7 @@ use crate::rng::StepKey;
 use crate::layout::{groups, view, Planes};
 #[cfg(target_has_atomic = "8")]
 use crate::tasks::Host;
-use crate::world::{Counters, Header, World};
+use crate::world::{Counters, World};
 
 /// The block order of a step. Blocks are independent (M3, M8); the reverse
 /// order exists so tests can show that the result does not depend on it.
@@ -157,10 +157,13 @@ impl World {
         route: Route,
         visit: impl FnOnce(&Shared<'_>, Writable<'_, Q, D>, bool) -> Counters,
     ) {
-        let Setup { head, shared, velocity, occupancy, rows, words, mass_index, life } = self.setup(route, Q::SCALE);
-        let planes = Writable { occupancy, rows, words, velocity: Cells::new(groups(view::<Q>(velocity))), mass_index, life };
-        let c = visit(&shared, planes, route.reverse);
-        head.count_step(&c, shared.part.total_blocks());
+        // The shared data read where `setup` wrote it (moved out, it would
+        // be a copy of some 280 bytes).
+        let s = self.setup(route, Q::SCALE);
+        let velocity = Cells::new(groups(view::<Q>(s.velocity)));
+        let planes = Writable { occupancy: s.occupancy, rows: s.rows, words: s.words, velocity, mass_index: s.mass_index, life: s.life };
+        let c = visit(&s.shared, planes, route.reverse);
+        count_step(s.counters, &c, s.shared.part.total_blocks());
     }
 
     /// A step's [`Setup`] for a velocity width of `scale` quanta per unit
@@ -171,8 +174,17 @@ impl World {
         // Read by the potential's gradient alone, which only `fields` has.
         let periodic = if cfg!(feature = "fields") { self.periodic() } else { [false; 3] };
         let dim = self.dim();
-        let desc = self.head.desc;
+        // Without `small-step` the blocks read a copy of the description
+        // (`StepDescription`), taken here, before the header is borrowed:
+        // a copy made through the borrow would be a `memmove` (the
+        // compiler cannot tell that the two do not overlap), a routine of
+        // 1.3 KB on a small core.
+        #[cfg(not(feature = "small-step"))]
+        let copy = self.head.desc;
         let (head, p) = self.planes::<u8>();
+        // The description and the counters, borrowed from the header
+        // together.
+        let (desc, counters) = (&head.desc, &mut head.counters);
         let Layout { n, .. } = head.layout;
         let Planes { occupancy, rows, words, obstacle, velocity, mass_index, life, field, potential, wind, mass_table, surface, .. } = p;
         let forces = desc.built_forces();
@@ -192,7 +204,10 @@ impl World {
         let summed = forces.any_field() || desc.has_drag();
         let plain = route.lean && !desc.has_masses() && !desc.lifetimes && !summed;
         let shared = Shared {
+            #[cfg(feature = "small-step")]
             desc,
+            #[cfg(not(feature = "small-step"))]
+            desc: copy,
             n,
             part,
             key: StepKey::blocks(desc.seed, head.step),
@@ -217,7 +232,7 @@ impl World {
             lanes: plain && !desc.has_contacts(),
         };
         Setup {
-            head,
+            counters,
             shared,
             velocity,
             occupancy: Cells::new(occupancy),
@@ -231,10 +246,10 @@ impl World {
 
 /// A step set up for its sweep, whatever its velocity width: the data every
 /// block reads, the planes blocks write but the velocities (as bytes: the
-/// width's routine views them as its own type) and the header the step's
-/// counters go to.
+/// width's routine views them as its own type) and the world's counters,
+/// which the step's go to.
 struct Setup<'a> {
-    head: &'a mut Header,
+    counters: &'a mut Counters,
     shared: Shared<'a>,
     velocity: &'a mut [u8],
     occupancy: Cells<'a, u64>,
@@ -244,16 +259,13 @@ struct Setup<'a> {
     life: Cells<'a, u16>,
 }
 
-impl Header {
-    /// Adds a step's counters `c` to the world's; the partition had `total`
-    /// blocks.
-    fn count_step(&mut self, c: &Counters, total: u64) {
-        let h = &mut self.counters;
-        h.add_step(c);
-        h.particles -= c.exited + c.expired;
-        h.processed = c.processed;
-        h.skipped = total - c.processed;
-    }
+/// Adds a step's counters `c` to the world's `h`; the partition had
+/// `total` blocks.
+fn count_step(h: &mut Counters, c: &Counters, total: u64) {
+    h.add_step(c);
+    h.particles -= c.exited + c.expired;
+    h.processed = c.processed;
+    h.skipped = total - c.processed;
 }
 
 fn run<Q: Quant, const D: usize, const CELLS: usize>(w: &mut World, route: Route, split: Split<'_>) {

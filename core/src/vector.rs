@@ -19,9 +19,123 @@ pub(crate) fn dot_of<const D: usize>(a: [f32; 3], b: [f32; 3]) -> f32 {
     sum
 }
 
+/// The larger of `a` and `b`, neither of them NaN: `f32::max` without the
+/// library's `fmaxf` (a call on cores without the instruction), whose NaN
+/// rules such inputs never need.
+#[inline(always)]
+pub(crate) fn larger(a: f32, b: f32) -> f32 {
+    if a > b { a } else { b }
+}
+
+/// `x as u64` (toward zero; NaN and below 0 give 0, from 2^64 on
+/// `u64::MAX`) from the bits of `x`: on 32-bit cores the cast is a library
+/// routine of some 80 bytes.
+pub(crate) fn saturating_u64(x: f32) -> u64 {
+    let bits = x.to_bits();
+    // Negative (sign set) or NaN (above the bits of infinity): 0.
+    if bits >= 0x8000_0000 || bits > 0x7f80_0000 {
+        return 0;
+    }
+    let exponent = (bits >> 23) as i32 - 127;
+    if exponent < 0 {
+        return 0;
+    }
+    if exponent >= 64 {
+        return u64::MAX;
+    }
+    let mantissa = u64::from(bits & 0x7f_ffff | 0x80_0000);
+    if exponent >= 23 { mantissa << (exponent - 23) } else { mantissa >> (23 - exponent) }
+}
+
+/// The square root, correctly rounded as IEEE 754 asks and as
+/// `libm::sqrtf` gives it. On Arm cores with a hard-float unit (the
+/// `eabihf` targets: VFP, which has the instruction) one `vsqrt.f32`,
+/// where libm is a software routine of some 260 bytes and a 256-byte
+/// table; elsewhere libm's (an instruction too where libm has one).
+#[inline(always)]
+pub(crate) fn sqrt(x: f32) -> f32 {
+    #[cfg(all(target_arch = "arm", target_abi = "eabihf"))]
+    {
+        let root: u32;
+        // Through s0, saved and restored around it: Rust names the FPU's
+        // registers in `asm!` only for double-precision units, and the
+        // Cortex-M4F's is single-precision.
+        // SAFETY: the instructions touch s0 (restored), the stack (balanced)
+        // and nothing else; hard-float code has the FPU on.
+        unsafe {
+            core::arch::asm!(
+                "vpush {{s0}}",
+                "vmov s0, {x}",
+                "vsqrt.f32 s0, s0",
+                "vmov {root}, s0",
+                "vpop {{s0}}",
+                x = in(reg) x.to_bits(),
+                root = lateout(reg) root,
+                options(pure, nomem, preserves_flags),
+            )
+        };
+        f32::from_bits(root)
+    }
+    #[cfg(all(target_arch = "arm", not(target_abi = "eabihf")))]
+    {
+        bitwise_sqrt(x)
+    }
+    #[cfg(not(target_arch = "arm"))]
+    libm::sqrtf(x)
+}
+
+/// The square root of a non-negative `x` digit by digit in integers,
+/// correctly rounded: for Arm cores without a floating-point unit, where
+/// libm's routine and its table take some 580 bytes. `x` is never
+/// negative or NaN here (squared lengths, uniform draws); for those it
+/// gives NaN, for -0 and +infinity `x`. The tests hold it to libm bit for
+/// bit.
+#[cfg_attr(not(all(target_arch = "arm", not(target_abi = "eabihf"))), allow(dead_code))]
+fn bitwise_sqrt(x: f32) -> f32 {
+    let bits = x.to_bits();
+    if bits & 0x7fff_ffff == 0 || bits == 0x7f80_0000 {
+        return x; // +-0, +infinity
+    }
+    if bits > 0x7f80_0000 {
+        return f32::NAN; // negative or NaN
+    }
+    // x = m 2^(k - 23) with m of 24 significant bits.
+    let (mut m, mut k) = (bits & 0x7f_ffff, (bits >> 23) as i32 - 127);
+    if bits >> 23 == 0 {
+        // Subnormal: its top bit brought to bit 23.
+        let shift = m.leading_zeros() - 8;
+        m <<= shift;
+        k = -126 - shift as i32;
+    } else {
+        m |= 0x80_0000;
+    }
+    if k & 1 != 0 {
+        // An even exponent, so that it halves exactly.
+        m <<= 1;
+        k -= 1;
+    }
+    // sqrt(x) = sqrt(m 2^23) 2^(k/2 - 23): the root of n = m 2^23 (below
+    // 2^48) to 24 bits, a bit at a time.
+    let mut rest = u64::from(m) << 23;
+    let (mut root, mut bit) = (0u64, 1u64 << 46);
+    while bit != 0 {
+        if rest >= root + bit {
+            rest -= root + bit;
+            root = (root >> 1) + bit;
+        } else {
+            root >>= 1;
+        }
+        bit >>= 2;
+    }
+    // Nearest: up where n > (root + 1/2)^2 = root^2 + root + 1/4, that is
+    // rest > root (never a tie). A root of 2^24 carries into the exponent.
+    let root = root as u32 + u32::from(rest > root);
+    f32::from_bits((((k / 2 + 127) as u32) << 23) + (root - 0x80_0000))
+}
+
 /// `v / |v|`, or `None` where the length is zero or not finite.
 pub(crate) fn normalise(v: [f32; 3]) -> Option<[f32; 3]> {
-    let len = libm::sqrtf(dot(v, v));
+    let len = sqrt(dot(v, v));
     (len.is_finite() && len > 1e-6).then(|| [v[0] / len, v[1] / len, v[2] / len])
 }
 
@@ -62,7 +176,7 @@ pub(crate) fn clamp_long(mut v: [f32; 3], s2: f32, limit: f32) -> ([f32; 3], f32
         for c in v.iter_mut() {
             *c /= limit;
         }
-        let big = v.iter().filter(|c| !c.is_nan()).fold(0.0f32, |b, c| b.max(c.abs()));
+        let big = v.iter().filter(|c| !c.is_nan()).fold(0.0f32, |b, c| larger(b, c.abs()));
         for c in v.iter_mut() {
             *c = if c.is_nan() || big == 0.0 {
                 0.0
@@ -82,7 +196,7 @@ pub(crate) fn clamp_long(mut v: [f32; 3], s2: f32, limit: f32) -> ([f32; 3], f32
         }
         return (*v, f32::INFINITY);
     }
-    let scale = limit / libm::sqrtf(s2);
+    let scale = limit / sqrt(s2);
     for c in v.iter_mut() {
         *c *= scale;
     }
@@ -92,6 +206,48 @@ pub(crate) fn clamp_long(mut v: [f32; 3], s2: f32, limit: f32) -> ([f32; 3], f32
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn bitwise_sqrt_is_libms() {
+        // Expect: libm's sqrtf bit for bit for every non-negative float
+        // at the edges of each exponent and 300,000 random ones, and +0,
+        // -0, infinity; NaN for negatives and NaN.
+        let check = |x: f32| assert_eq!(bitwise_sqrt(x).to_bits(), libm::sqrtf(x).to_bits(), "{x:e} {:#x}", x.to_bits());
+        for e in 0..255u32 {
+            for k in 0..64 {
+                check(f32::from_bits((e << 23) + k));
+                check(f32::from_bits(((e << 23) | 0x7f_ffff) - k));
+            }
+        }
+        let mut bits = 0x0bad_cafeu32;
+        for _ in 0..crate::sized(300_000, 3_000) {
+            bits = bits.wrapping_mul(0x9e37_79b9).wrapping_add(0x7f4a_7c15);
+            check(f32::from_bits(bits & 0x7fff_ffff).min(f32::MAX));
+        }
+        check(f32::INFINITY);
+        check(-0.0);
+        assert!(bitwise_sqrt(-1.0).is_nan() && bitwise_sqrt(f32::NAN).is_nan() && bitwise_sqrt(-f32::MIN_POSITIVE).is_nan());
+    }
+
+    #[test]
+    fn saturating_u64_is_the_cast() {
+        // Expect: `as u64` bit for bit, for every exponent's neighbours,
+        // both signs, zeros, infinities, NaNs and random bit patterns.
+        let check = |x: f32| assert_eq!(saturating_u64(x), x as u64, "{x:e} {:#x}", x.to_bits());
+        for e in 0..256u32 {
+            for k in 0..4 {
+                for sign in [0, 0x8000_0000] {
+                    check(f32::from_bits(sign | ((e << 23) + k)));
+                    check(f32::from_bits(sign | (((e << 23) | 0x7f_ffff) - k)));
+                }
+            }
+        }
+        let mut bits = 0x1234_5678u32;
+        for _ in 0..crate::sized(200_000, 2_000) {
+            bits = bits.wrapping_mul(0x9e37_79b9).wrapping_add(0x7f4a_7c15);
+            check(f32::from_bits(bits));
+        }
+    }
 
     #[test]
     fn clamp_survives_overflow() {

@@ -9,7 +9,7 @@
 use core::mem::{align_of, size_of};
 
 use crate::desc::Description;
-use crate::layout::{test_bit, view, view_ref, Layout, Plain, Planes, Site};
+use crate::layout::{test_bit, view, view_counted, view_ref, Layout, Plain, Planes, Site};
 use crate::Error;
 
 /// Counters the step keeps. All integers (clamped energy in 2^-32 units),
@@ -33,18 +33,20 @@ impl Counters {
     /// Adds what a sweep of blocks counts (a task's share of a step). The
     /// running totals saturate: an image (M12) may carry any count.
     pub fn add_step(&mut self, c: &Counters) {
-        for (total, add) in [
-            (&mut self.exited, c.exited),
-            (&mut self.expired, c.expired),
-            (&mut self.collisions, c.collisions),
-            (&mut self.clamps, c.clamps),
-            (&mut self.clamp_energy, c.clamp_energy),
-            (&mut self.displaced, c.displaced),
-            (&mut self.processed, c.processed),
-        ] {
-            *total = total.saturating_add(add);
-        }
+        add(&mut self.exited, c.exited);
+        add(&mut self.expired, c.expired);
+        add(&mut self.collisions, c.collisions);
+        add(&mut self.clamps, c.clamps);
+        add(&mut self.clamp_energy, c.clamp_energy);
+        add(&mut self.displaced, c.displaced);
+        add(&mut self.processed, c.processed);
     }
+}
+
+/// `total += more`, saturating. Out of line: one copy for every counter.
+#[inline(never)]
+fn add(total: &mut u64, more: u64) {
+    *total = total.saturating_add(more);
 }
 
 /// 2^32, the scale of the clamped-energy accumulator (which saturates at
@@ -116,32 +118,27 @@ impl World {
         debug_assert_eq!(region.len() % 8, 0);
         view::<u64>(region).fill(0);
         let base = region.as_mut_ptr();
-        let mut desc = *desc;
-        if desc.dim == 2 {
-            desc.size[2] = 1;
-        }
-        let head = Header {
-            tag: TAG ^ base as u64,
-            len: layout.total,
-            desc,
-            layout,
-            step: 0,
-            counters: Counters::default(),
-            masses: 0,
-            surfaces: 0,
-            emitters: 0,
-            owned: 0,
-        };
+        let h = base.cast::<Header>();
         // SAFETY: `base` is aligned for Header (pad above) and the region
-        // holds size_of::<Header>() + layout.total bytes, borrowed for 'a.
-        // The fat pointer's metadata is the length of the trailing [u8].
+        // holds size_of::<Header>() + layout.total bytes, borrowed for 'a
+        // and all 0. The fields are written in place (a Header built on the
+        // stack and copied over would be a `memcpy` of some 390 bytes);
+        // those not written (the step, the counters and the table counts)
+        // are integers, for which the zero bytes are the value 0. The fat
+        // pointer's metadata is the length of the trailing [u8].
         unsafe {
-            base.cast::<Header>().write(head);
+            core::ptr::addr_of_mut!((*h).tag).write(TAG ^ base as u64);
+            core::ptr::addr_of_mut!((*h).len).write(layout.total);
+            core::ptr::addr_of_mut!((*h).desc).write(*desc);
+            core::ptr::addr_of_mut!((*h).layout).write(layout);
             let world = core::ptr::slice_from_raw_parts_mut(base, layout.total) as *mut World;
             let world = &mut *world;
-            if desc.has_masses() {
+            if world.head.desc.dim == 2 {
+                world.head.desc.size[2] = 1;
+            }
+            if world.head.desc.has_masses() {
                 // Class 0 is the description's mass, for particles added without one.
-                world.planes::<i8>().1.mass_table[0] = desc.mass;
+                world.planes::<i8>().1.mass_table[0] = world.head.desc.mass;
                 world.head.masses = 1;
             }
             Ok(world)
@@ -222,20 +219,25 @@ impl World {
             rest = r;
             mine
         };
+        // A plane of a part the build leaves out is empty in every layout
+        // (`Layout::of` refuses a description that would need it): no
+        // split, and no code, for it; an empty slice of its own type
+        // stands for it.
+        let (obstacles, mass, fields) = (cfg!(feature = "obstacles"), cfg!(feature = "mass"), cfg!(feature = "fields"));
         let planes = Planes {
             occupancy: view(take(l.occupancy)),
             rows: take(l.rows),
             words: view(take(l.words)),
-            obstacle: view(take(l.obstacle)),
+            obstacle: if obstacles { view(take(l.obstacle)) } else { &mut [] },
             velocity: view(take(l.velocity)),
-            mass_index: take(l.mass_index),
+            mass_index: if mass { take(l.mass_index) } else { &mut [] },
             life: view(take(l.life)),
-            field: view(take(l.field)),
-            potential: view(take(l.potential)),
-            wind: view(take(l.wind)),
-            mass_table: view(take(l.mass_table)),
-            surface: view(take(l.surface)),
-            emitters: view(take(l.emitters)),
+            field: if fields { view(take(l.field)) } else { &mut [] },
+            potential: if fields { view(take(l.potential)) } else { &mut [] },
+            wind: if fields { view(take(l.wind)) } else { &mut [] },
+            mass_table: if mass { view(take(l.mass_table)) } else { &mut [] },
+            surface: if obstacles { view(take(l.surface)) } else { &mut [] },
+            emitters: view_counted(take(l.emitters), self.head.desc.emitter_capacity as usize),
         };
         (&mut self.head, planes)
     }
@@ -246,7 +248,7 @@ impl World {
 
     /// The bytes of plane `p`: the part of [`World::plane`] that does not
     /// depend on the type, so that it exists once.
-    fn plane_bytes(&self, p: crate::layout::Plane) -> &[u8] {
+    pub(crate) fn plane_bytes(&self, p: crate::layout::Plane) -> &[u8] {
         &self.mem[p.off..p.off + p.len]
     }
 

@@ -316,9 +316,11 @@ pub unsafe extern "C" fn mpca_desc_validate(desc: *const mpca_desc) -> mpca_stat
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_world_bytes(desc: *const mpca_desc, out_bytes: *mut usize) -> mpca_status {
     guard(|c| {
-        let d = c.get(desc)?.to_core()?;
+        // Read inside the result (moved out, it would be copied).
+        let d = c.get(desc)?.to_core();
+        let d = d.as_ref().map_err(|&s| s)?;
         let out = c.out(out_bytes)?;
-        out.set(mpca_core::world_bytes(&d)?);
+        out.set(mpca_core::world_bytes(d)?);
         Ok(())
     })
 }

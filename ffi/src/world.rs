@@ -58,11 +58,13 @@ pub unsafe extern "C" fn mpca_world_init(
     out_world: *mut *mut mpca_world,
 ) -> mpca_status {
     guard(|c| {
-        let d = c.get(desc)?.to_core()?;
+        // Read inside the result (moved out, it would be copied).
+        let d = c.get(desc)?.to_core();
+        let d = d.as_ref().map_err(|&s| s)?;
         let out = c.out(out_world)?;
         let bytes = c.slice_mut(memory.cast::<u8>(), len, mpca_status::BadLength)?;
         let number = handle::reserve()?;
-        let world = World::init(&d, bytes)?;
+        let world = World::init(d, bytes)?;
         out.set(handle::issue(number, world));
         Ok(())
     })
