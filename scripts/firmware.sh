@@ -36,11 +36,12 @@ esac
 TEXT_BUDGET=16384   # .text, on each core
 RODATA_BUDGET=8192  # .rodata
 RAM_BUDGET=16384    # .data + .bss + the stack's high-water mark
-# Enforced: RAM and .rodata (met on both cores). NOT enforced: .text, which
-# the M4F meets and the M0 does not yet (soft float, the general block
-# routine: see the largest symbols this script prints); set ENFORCE_TEXT to
-# 1 once both do, so that CI holds it.
-ENFORCE_TEXT=0
+# Enforced: RAM and .rodata (met on both cores), and .text on the cores
+# that meet it, so that CI holds what is won. ENFORCE_TEXT lists them: the
+# M4F; the M0 does not yet (soft float, the general block routine: see the
+# largest symbols this script prints), so its .text is only reported; add
+# it once it does.
+ENFORCE_TEXT="m4f"
 ENFORCE_RODATA=1
 
 need=()
@@ -182,7 +183,7 @@ for variant in "${variants[@]}"; do
                 echo "firmware: $core RAM $ram > $RAM_BUDGET (enforced)" >&2
                 failures=$((failures + 1))
             fi
-            if [ "$text" -gt $TEXT_BUDGET ] && [ $ENFORCE_TEXT = 1 ]; then
+            if [ "$text" -gt $TEXT_BUDGET ] && [[ " $ENFORCE_TEXT " == *" $core "* ]]; then
                 echo "firmware: $core .text $text > $TEXT_BUDGET (enforced)" >&2
                 failures=$((failures + 1))
             fi
@@ -206,7 +207,7 @@ for row in "${rows[@]}"; do
     printf '%-7s %-4s %7s %8s %6s %6s %6s %6s %11s %12s  %s\n' $row
 done
 enforced() { if [ "$1" = 1 ]; then echo ' (enforced)'; else echo ' (not yet enforced)'; fi; }
-echo "budgets (opt-level z): .text <= $TEXT_BUDGET on each core$(enforced $ENFORCE_TEXT);" \
+echo "budgets (opt-level z): .text <= $TEXT_BUDGET on each core (enforced on: $ENFORCE_TEXT);" \
     ".rodata <= $RODATA_BUDGET$(enforced $ENFORCE_RODATA); RAM <= $RAM_BUDGET (enforced)"
 
 if [ "$table" = 1 ] && command -v valgrind >/dev/null; then
