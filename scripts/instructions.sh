@@ -10,11 +10,53 @@
 #   scripts/instructions.sh --assign        M5.6 alone: instructions per 3D block
 #                                           by particles per block, exact-fast
 #                                           against greedy (issue 8's ratio)
+#   scripts/instructions.sh --classes       M5.6 by occupancy class: instructions per
+#                                           3D block for every K particles and F free
+#                                           cells (K <= F <= 8), exact-fast against
+#                                           exhaustive and greedy; a wish for a blocked
+#                                           cell is staying, as M5.4 makes it
+#   scripts/instructions.sh --classes raw   the same, such wishes kept (a direct
+#                                           caller of assign_moves may pose them)
+#   scripts/instructions.sh --classes [raw] searched
+#                                           only the blocks where two particles want
+#                                           one cell or one wants a blocked cell: those
+#                                           that need a search
 #
 # Installs valgrind with apt-get when it is missing.
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 command -v valgrind >/dev/null || scripts/install-missing.sh valgrind
+
+if [ "${1:-}" = "--classes" ]; then
+    cargo build --release -q -p mpca-tests --bin assign_blocks
+    out=$(mktemp -d)
+    trap 'rm -rf "$out"' EXIT
+    blocks=4000
+    shift
+    # Instructions per block of `solve` for (K, FREE, METHOD, words), 3D
+    # random blocks, or "-" where there are no such blocks.
+    per_block() {
+        local k=$1 f=$2 method=$3 solved
+        shift 3
+        solved=$(valgrind --tool=callgrind --callgrind-out-file="$out/cg" --collect-atstart=no \
+            --toggle-collect='*assign_blocks*solve*' target/release/assign_blocks 3 "$k" "$method" $blocks "$f" "$@" 2>/dev/null |
+            awk '$2 == "blocks" {print $1}')
+        [ -n "$solved" ] || { printf -- -; return; }
+        awk -v n="$solved" '/^(summary|totals):/{printf "%.0f", $2 / n; exit}' "$out/cg"
+    }
+    printf '%-9s %5s %11s %11s %11s %8s %8s\n' particles free exact-fast exhaustive greedy ef/exh ef/gr
+    for k in 1 2 3 4 5 6 7 8; do
+        for f in $(seq "$k" 8); do
+            e=$(per_block "$k" "$f" exact-fast "$@")
+            x=$(per_block "$k" "$f" exhaustive "$@")
+            g=$(per_block "$k" "$f" greedy "$@")
+            awk -v k="$k" -v f="$f" -v e="$e" -v x="$x" -v g="$g" 'BEGIN {
+                if (e == "-") { printf "%-9s %5s %11s %11s %11s\n", k, f, e, x, g; exit }
+                printf "%-9s %5s %11d %11d %11d %8.2f %8.2f%s\n", k, f, e, x, g, e / x, e / g, (e > x ? "  slower than exhaustive" : "") }'
+        done
+    done
+    exit 0
+fi
 
 if [ "${1:-}" = "--assign" ]; then
     cargo build --release -q -p mpca-tests --bin assign_blocks
