@@ -4,7 +4,7 @@
 //! the number of particles in it (and of free cells), without the rest of
 //! the step.
 //!
-//!     assign_blocks DIM K METHOD [BLOCKS [FREE [raw] [searched]]]
+//!     assign_blocks DIM K METHOD [BLOCKS [FREE [raw] [searched] [each]]]
 //!
 //! DIM is 2 or 3, K the particles per block (1 to 2^DIM), METHOD
 //! `exhaustive`, `exact-fast` or `greedy`, BLOCKS the number of blocks
@@ -14,8 +14,11 @@
 //! particles are in and FREE - K of the others, drawn at random; the rest
 //! are blocked. A particle that wants a blocked cell then stays, as M5.4
 //! makes that wish in the step, unless `raw` is given: then it keeps the
-//! wish, as a direct caller of `assign_moves` may pose it. Prints the blocks
-//! solved.
+//! wish, as a direct caller of `assign_moves` may pose it. With `each`,
+//! [`solve`] is called once with no block and then once per block (a fresh
+//! stream each time), for `--per-block`, which has callgrind dump a
+//! profile before each call and so counts every block apart. Prints the
+//! blocks solved.
 
 use mpca::assign::{assign_moves, MoveProblem};
 use mpca::rng::block_stream;
@@ -65,7 +68,7 @@ fn needs_search(p: &MoveProblem) -> bool {
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let usage = "usage: assign_blocks DIM K METHOD [BLOCKS [FREE [raw] [searched]]]";
+    let usage = "usage: assign_blocks DIM K METHOD [BLOCKS [FREE [raw] [searched] [each]]]";
     let (Some(dim), Some(k), Some(method)) = (args.first(), args.get(1), args.get(2)) else {
         eprintln!("{usage}");
         std::process::exit(2);
@@ -86,7 +89,8 @@ fn main() {
     let words = &args[args.len().min(5)..];
     let raw = words.iter().any(|w| w == "raw");
     let searched = words.iter().any(|w| w == "searched");
-    assert!(words.iter().all(|w| w == "raw" || w == "searched"), "{usage}");
+    let each = words.iter().any(|w| w == "each");
+    assert!(words.iter().all(|w| ["raw", "searched", "each"].contains(&w.as_str())), "{usage}");
     let mut set = Vec::with_capacity(blocks);
     for seed in 5..69 {
         let mut batch = problems(dim, k, blocks, seed);
@@ -104,7 +108,14 @@ fn main() {
     }
     set.truncate(blocks);
     let blocks = set.len();
-    let sum = if dim == 2 { solve::<2>(method, &set) } else { solve::<3>(method, &set) };
+    let sum = match (dim, each) {
+        (2, false) => solve::<2>(method, &set),
+        (_, false) => solve::<3>(method, &set),
+        // A call with no block first, whose count is what a call costs
+        // besides its blocks.
+        (2, true) => solve::<2>(method, &[]) + set.iter().map(|p| solve::<2>(method, std::slice::from_ref(p))).sum::<u64>(),
+        (_, true) => solve::<3>(method, &[]) + set.iter().map(|p| solve::<3>(method, std::slice::from_ref(p))).sum::<u64>(),
+    };
     // The sum keeps the work from being optimised away.
     println!("{blocks} blocks ({sum})");
 }
