@@ -10,11 +10,95 @@
 #   scripts/instructions.sh --assign        M5.6 alone: instructions per 3D block
 #                                           by particles per block, exact-fast
 #                                           against greedy (issue 8's ratio)
+#   scripts/instructions.sh --classes       M5.6 by occupancy class: instructions per
+#                                           3D block for every K particles and F free
+#                                           cells (K <= F <= 8), exact-fast against
+#                                           exhaustive and greedy; a wish for a blocked
+#                                           cell is staying, as M5.4 makes it
+#   scripts/instructions.sh --classes raw   the same, such wishes kept (a direct
+#                                           caller of assign_moves may pose them)
+#   scripts/instructions.sh --classes [raw] searched
+#                                           only the blocks where two particles want
+#                                           one cell or one wants a blocked cell: those
+#                                           that need a search
+#   scripts/instructions.sh --per-block [raw] [searched]
+#                                           the same classes of up to 5 free cells block
+#                                           by block (400 each): how many blocks cost
+#                                           exact-fast more than exhaustive, by how much
 #
 # Installs valgrind with apt-get when it is missing.
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 command -v valgrind >/dev/null || scripts/install-missing.sh valgrind
+
+if [ "${1:-}" = "--classes" ]; then
+    cargo build --release -q -p mpca-tests --bin assign_blocks
+    out=$(mktemp -d)
+    trap 'rm -rf "$out"' EXIT
+    blocks=4000
+    shift
+    # Instructions per block of `solve` for (K, FREE, METHOD, words), 3D
+    # random blocks, or "-" where there are no such blocks.
+    per_block() {
+        local k=$1 f=$2 method=$3 solved
+        shift 3
+        solved=$(valgrind --tool=callgrind --callgrind-out-file="$out/cg" --collect-atstart=no \
+            --toggle-collect='*assign_blocks*solve*' target/release/assign_blocks 3 "$k" "$method" $blocks "$f" "$@" 2>/dev/null |
+            awk '$2 == "blocks" {print $1}')
+        [ -n "$solved" ] || { printf -- -; return; }
+        awk -v n="$solved" '/^(summary|totals):/{printf "%.0f", $2 / n; exit}' "$out/cg"
+    }
+    printf '%-9s %5s %11s %11s %11s %8s %8s\n' particles free exact-fast exhaustive greedy ef/exh ef/gr
+    for k in 1 2 3 4 5 6 7 8; do
+        for f in $(seq "$k" 8); do
+            e=$(per_block "$k" "$f" exact-fast "$@")
+            x=$(per_block "$k" "$f" exhaustive "$@")
+            g=$(per_block "$k" "$f" greedy "$@")
+            awk -v k="$k" -v f="$f" -v e="$e" -v x="$x" -v g="$g" 'BEGIN {
+                if (e == "-") { printf "%-9s %5s %11s %11s %11s\n", k, f, e, x, g; exit }
+                printf "%-9s %5s %11d %11d %11d %8.2f %8.2f%s\n", k, f, e, x, g, e / x, e / g, (e > x ? "  slower than exhaustive" : "") }'
+        done
+    done
+    exit 0
+fi
+
+if [ "${1:-}" = "--per-block" ]; then
+    cargo build --release -q -p mpca-tests --bin assign_blocks
+    out=$(mktemp -d)
+    trap 'rm -rf "$out"' EXIT
+    blocks=400
+    shift
+    # Instructions of each block of `solve` for (K, FREE, METHOD, words), one
+    # a line, less those of a call with no block: callgrind dumps a profile
+    # before every call, the first after the call with no block.
+    each_block() {
+        local k=$1 f=$2 method=$3 files
+        shift 3
+        rm -f "$out"/cg*
+        valgrind --tool=callgrind --callgrind-out-file="$out/cg" --collect-atstart=no \
+            --toggle-collect='*assign_blocks*solve*' --dump-before='assign_blocks::solve' \
+            target/release/assign_blocks 3 "$k" "$method" $blocks "$f" "$@" each >/dev/null 2>&1
+        files=$(find "$out" -name 'cg*' | wc -l)
+        [ "$files" -gt 2 ] || return 0
+        for i in $(seq 2 $((files - 1))) cg; do
+            [ "$i" = cg ] && file="$out/cg" || file="$out/cg.$i"
+            awk '/^(summary|totals):/{print $2; exit}' "$file"
+        done | awk 'NR == 1 {call = $1; next} {print $1 - call}'
+    }
+    printf '%-9s %5s %7s %13s %12s %10s\n' particles free blocks "ef>exhaustive" "most extra" "most ratio"
+    for k in 1 2 3 4 5; do
+        for f in $(seq "$k" 5); do
+            each_block "$k" "$f" exact-fast "$@" >"$out/ef"
+            each_block "$k" "$f" exhaustive "$@" >"$out/exh"
+            [ -s "$out/ef" ] || { printf '%-9s %5s %7s\n' "$k" "$f" -; continue; }
+            paste "$out/ef" "$out/exh" | awk -v k="$k" -v f="$f" '{
+                n++; if ($1 > $2) { slower++; if ($1 - $2 > extra) extra = $1 - $2 }
+                if ($1 / $2 > ratio) ratio = $1 / $2 }
+                END { printf "%-9s %5s %7d %13d %12d %10.2f\n", k, f, n, slower, extra, ratio }'
+        done
+    done
+    exit 0
+fi
 
 if [ "${1:-}" = "--assign" ]; then
     cargo build --release -q -p mpca-tests --bin assign_blocks
