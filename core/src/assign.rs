@@ -976,7 +976,15 @@ fn min_lane(lanes: &Lanes) -> i16 {
     half[0].min(half[2]).min(half[1].min(half[3]))
 }
 
-/// One optimal assignment, uniformly, from the placed prices.
+/// One optimal assignment, uniformly, from the placed prices: [`choose`]
+/// among the assignments along tight cells that fill every cell with lift.
+fn pick(prices: &Prices, count: usize, draw: impl FnOnce(u32) -> u32) -> Assignment {
+    choose(prices.at, count, |i| prices.tight(i), || prices.must(), draw)
+}
+
+/// One of the assignments that put each particle `i` in a cell of
+/// `tight_of(i)` and fill every cell of `must()`, uniformly; `target` is
+/// one of them, and all of them are optimal.
 ///
 /// A particle with one tight cell takes it in every optimal assignment, so
 /// that cell is struck from the others' tight cells, until no particle left
@@ -984,13 +992,19 @@ fn min_lane(lanes: &Lanes) -> i16 {
 /// choices are independent. Each group's ways are counted, the total is
 /// their product, and one draw of a rank, read digit by digit in the
 /// groups' counts, picks a way in every group.
-fn pick(prices: &Prices, count: usize, draw: impl FnOnce(u32) -> u32) -> Assignment {
-    let mut target = prices.at;
+#[inline(always)]
+fn choose(
+    mut target: [u8; MAX_CELLS],
+    count: usize,
+    tight_of: impl Fn(usize) -> u8,
+    must: impl FnOnce() -> u8,
+    draw: impl FnOnce(u32) -> u32,
+) -> Assignment {
     let mut tight = [0u8; MAX_CELLS];
     // The particles with a choice, and the cells of those without.
     let (mut open, mut taken) = (0u8, 0u8);
     for (i, cells) in tight.iter_mut().enumerate().take(count) {
-        *cells = prices.tight(i);
+        *cells = tight_of(i);
         let several = *cells & (*cells - 1) != 0;
         open |= u8::from(several) << i;
         taken |= *cells & u8::from(several).wrapping_sub(1);
@@ -1013,7 +1027,7 @@ fn pick(prices: &Prices, count: usize, draw: impl FnOnce(u32) -> u32) -> Assignm
         }
         open &= !settled;
     }
-    let must = prices.must();
+    let must = must();
     let mut groups = [Group::default(); MAX_CELLS / 2];
     let mut found = 0;
     let mut total = 1u32;
@@ -2141,3 +2155,4 @@ mod tests {
         }
     }
 }
+
