@@ -32,9 +32,8 @@
 //!   cell (944 of the 1296, among them the 815 the step can meet); the
 //!   others, which only a direct caller can pose, are solved when asked by
 //!   the programme that builds the table. In 3D the common blocks
-//!   are settled directly (every wish distinct and free; one or two
-//!   particles; three particles filling the only three free cells, each
-//!   of the six ways tried); otherwise the Hungarian method finds an optimal
+//!   are settled directly (every wish distinct and free; two particles
+//!   after one cell); otherwise the Hungarian method finds an optimal
 //!   assignment with prices that mark every pair an optimal assignment may
 //!   use, the optimal assignments along those pairs are counted, and one
 //!   draw picks among them.
@@ -500,10 +499,7 @@ const NONE: u8 = u8::MAX;
 /// 1. Every particle alone in wanting a free cell: each gets it, the only
 ///    assignment with cost1 = 0.
 /// 2. One or two particles: counted directly.
-/// 3. Three particles in exactly three free cells: the six assignments
-///    tried ([`three`]), numbered as step 4 numbers them, where the
-///    Hungarian method would cost more than exhaustive search.
-/// 4. Otherwise the Hungarian method finds one optimal assignment and
+/// 3. Otherwise the Hungarian method finds one optimal assignment and
 ///    prices that tell which (particle, cell) pairs any optimal assignment
 ///    may use; see [`pick`] for how those are counted and drawn from.
 fn exact_3d(problem: &MoveProblem, free: u8, count: usize, draw: impl FnOnce(u32) -> u32) -> Assignment {
@@ -522,25 +518,6 @@ fn exact_3d(problem: &MoveProblem, free: u8, count: usize, draw: impl FnOnce(u32
     if count <= 2 {
         return few(problem, free, count, draw);
     }
-    if count == 3 && three_cells(free) {
-        return three(problem, free, draw);
-    }
-    hungarian(problem, free, count, draw)
-}
-
-/// Whether `free` has exactly three cells: with its two lowest cleared, one
-/// is left (neither baseline x86-64 nor Cortex-M counts bits in one
-/// instruction).
-#[inline(always)]
-fn three_cells(free: u8) -> bool {
-    let two = free & free.wrapping_sub(1);
-    let one = two & two.wrapping_sub(1);
-    one != 0 && one & one.wrapping_sub(1) == 0
-}
-
-/// Step 4 of [`exact_3d`].
-#[inline(always)]
-fn hungarian(problem: &MoveProblem, free: u8, count: usize, draw: impl FnOnce(u32) -> u32) -> Assignment {
     let mut prices = Prices::start(problem, free, count);
     for i in 0..count {
         if prices.at[i] == NONE {
@@ -548,97 +525,6 @@ fn hungarian(problem: &MoveProblem, free: u8, count: usize, draw: impl FnOnce(u3
         }
     }
     pick(&prices, count, draw)
-}
-
-/// The six orders of three things, each with a fourth place (3) so that
-/// one indexed by a number below 4 needs no bounds check.
-const ORDERS_3: [[u8; 4]; 6] = [[0, 1, 2, 3], [0, 2, 1, 3], [1, 0, 2, 3], [1, 2, 0, 3], [2, 0, 1, 3], [2, 1, 0, 3]];
-
-/// Three particles and exactly three free cells, which they fill: the six
-/// assignments are tried, and one draw picks among the optimal ones in the
-/// order in which [`pick`] numbers them after the Hungarian method, so that
-/// the same draw gives the same assignment, for less than half the
-/// Hungarian method's cost on such a block and a fraction of exhaustive
-/// search's.
-///
-/// Each particle's choices are the cells it takes in some optimal
-/// assignment. Given these for the Hungarian method's tight cells, `pick`
-/// numbers the ways of every such block as it does after the Hungarian
-/// method (`three_cells_number_the_optima_as_pick_does` tries them all),
-/// and its numbering is short to state: all three cells are filled, so its
-/// one group (or one pair beside a particle with one choice) ends in one
-/// set of cells, whose ways [`Group::nth`] numbers in increasing order of
-/// the last member's cell, then the one before, and so on, the members in
-/// [`Group::fill`]'s order: those with two choices first, then the others,
-/// each in problem order.
-///
-/// Every index is masked to its array, so that nothing here can panic: a
-/// panic path in this function cost the water scene 6 instructions a block
-/// more (the step's sweep, which calls M5.6, compiled otherwise).
-#[inline(never)]
-fn three(problem: &MoveProblem, free: u8, draw: impl FnOnce(u32) -> u32) -> Assignment {
-    let second = free & (free - 1);
-    // The three cells, and a fourth place for the orders' fourth.
-    let cells = [free.trailing_zeros() as u8, second.trailing_zeros() as u8, (second & (second - 1)).trailing_zeros() as u8, 0];
-    let rows = [cost_row(problem, 0), cost_row(problem, 1), cost_row(problem, 2)];
-    let mut costs = [0u16; 6];
-    for (cost, order) in costs.iter_mut().zip(&ORDERS_3) {
-        for (row, &c) in rows.iter().zip(order) {
-            *cost += u16::from(row[usize::from(cells[usize::from(c & 3)] & 7)]);
-        }
-    }
-    let best = costs.iter().fold(u16::MAX, |best, &cost| best.min(cost));
-    // The optimal orders, the first of them, and the places (0, 1, 2) each
-    // particle takes in them.
-    let (mut optimal, mut ways) = (0u8, 0u32);
-    let mut chosen = &ORDERS_3[0];
-    let mut choices = [0u8; 3];
-    for ((o, order), &cost) in ORDERS_3.iter().enumerate().zip(&costs) {
-        if cost == best {
-            if ways == 0 {
-                chosen = order;
-            }
-            optimal |= 1 << o;
-            ways += 1;
-            for (choice, &c) in choices.iter_mut().zip(order) {
-                *choice |= 1 << c;
-            }
-        }
-    }
-    if ways > 1 {
-        let rank = draw(ways);
-        // The members in `Group::fill`'s order: at most two choices first
-        // (a particle with one takes the same cell in every way, so where
-        // it stands does not change the order of the ways).
-        let pairs = (0..3).fold(0u8, |pairs, i| {
-            let rest = choices[i] & choices[i].wrapping_sub(1);
-            pairs | u8::from(rest & rest.wrapping_sub(1) == 0) << i
-        });
-        let mut members = [0u8; 3];
-        for (slot, i) in members.iter_mut().zip(bits(pairs).chain(bits(!pairs & 7))) {
-            *slot = i as u8 & 3;
-        }
-        let key = |order: &[u8; 4]| {
-            let place = |k: usize| order[usize::from(members[k] & 3)];
-            place(2) << 4 | place(1) << 2 | place(0)
-        };
-        // The way of rank `rank` has `rank` optimal ways before it.
-        let before = |order: &[u8; 4]| {
-            let earlier = ORDERS_3.iter().enumerate().filter(|&(o, other)| optimal >> o & 1 != 0 && key(other) < key(order));
-            earlier.count() as u32
-        };
-        for (o, order) in ORDERS_3.iter().enumerate() {
-            if optimal >> o & 1 != 0 && before(order) == rank {
-                chosen = order;
-                break;
-            }
-        }
-    }
-    let mut target = [0u8; MAX_CELLS];
-    for (t, &c) in target.iter_mut().zip(&chosen[..3]) {
-        *t = cells[usize::from(c & 3)];
-    }
-    Assignment { target }
 }
 
 /// Particle `i`'s combined cost of each cell.
@@ -976,15 +862,7 @@ fn min_lane(lanes: &Lanes) -> i16 {
     half[0].min(half[2]).min(half[1].min(half[3]))
 }
 
-/// One optimal assignment, uniformly, from the placed prices: [`choose`]
-/// among the assignments along tight cells that fill every cell with lift.
-fn pick(prices: &Prices, count: usize, draw: impl FnOnce(u32) -> u32) -> Assignment {
-    choose(prices.at, count, |i| prices.tight(i), || prices.must(), draw)
-}
-
-/// One of the assignments that put each particle `i` in a cell of
-/// `tight_of(i)` and fill every cell of `must()`, uniformly; `target` is
-/// one of them, and all of them are optimal.
+/// One optimal assignment, uniformly, from the placed prices.
 ///
 /// A particle with one tight cell takes it in every optimal assignment, so
 /// that cell is struck from the others' tight cells, until no particle left
@@ -992,19 +870,13 @@ fn pick(prices: &Prices, count: usize, draw: impl FnOnce(u32) -> u32) -> Assignm
 /// choices are independent. Each group's ways are counted, the total is
 /// their product, and one draw of a rank, read digit by digit in the
 /// groups' counts, picks a way in every group.
-#[inline(always)]
-fn choose(
-    mut target: [u8; MAX_CELLS],
-    count: usize,
-    tight_of: impl Fn(usize) -> u8,
-    must: impl FnOnce() -> u8,
-    draw: impl FnOnce(u32) -> u32,
-) -> Assignment {
+fn pick(prices: &Prices, count: usize, draw: impl FnOnce(u32) -> u32) -> Assignment {
+    let mut target = prices.at;
     let mut tight = [0u8; MAX_CELLS];
     // The particles with a choice, and the cells of those without.
     let (mut open, mut taken) = (0u8, 0u8);
     for (i, cells) in tight.iter_mut().enumerate().take(count) {
-        *cells = tight_of(i);
+        *cells = prices.tight(i);
         let several = *cells & (*cells - 1) != 0;
         open |= u8::from(several) << i;
         taken |= *cells & u8::from(several).wrapping_sub(1);
@@ -1027,7 +899,7 @@ fn choose(
         }
         open &= !settled;
     }
-    let must = must();
+    let must = prices.must();
     let mut groups = [Group::default(); MAX_CELLS / 2];
     let mut found = 0;
     let mut total = 1u32;
@@ -2038,73 +1910,6 @@ mod tests {
         }
     }
 
-    /// What `solve` gives for every rank its draw could return, in rank
-    /// order (one assignment where it does not draw), the particles'
-    /// targets only; checks that it draws at most once.
-    fn targets_by_rank(count: usize, solve: impl Fn(&mut dyn FnMut(u32) -> u32) -> Assignment) -> Vec<Vec<u8>> {
-        let mut ways = None;
-        let first = solve(&mut |n| {
-            assert!(ways.replace(n).is_none(), "drew twice");
-            0
-        });
-        let ranks = ways.unwrap_or(1);
-        (0..ranks)
-            .map(|rank| {
-                let a = if ways.is_none() {
-                    first
-                } else {
-                    let mut drawn = false;
-                    solve(&mut |n| {
-                        assert!(!drawn && Some(n) == ways, "drew twice, or among {n}");
-                        drawn = true;
-                        rank
-                    })
-                };
-                a.target[..count].to_vec()
-            })
-            .collect()
-    }
-
-    #[test]
-    fn three_cells_number_the_optima_as_pick_does() {
-        // Expect: for every 3D block of three particles and exactly three
-        // free cells that exact-fast does not settle directly (every free
-        // mask of three cells, the particles on them in every order, every
-        // wish, blocked cells included: 172,032 blocks less those), the six
-        // assignments tried give, for every rank the draw can return, the
-        // assignment the Hungarian method and `pick` give for that rank,
-        // and draw among as many: the same draw, the same world. Under Miri
-        // every 997th block.
-        let every = crate::sized(1, 997);
-        for mask in 0..=255u8 {
-            assert_eq!(three_cells(mask), mask.count_ones() == 3, "{mask:#010b}");
-        }
-        let masks: Vec<u8> = (0..=255u8).filter(|f| f.count_ones() == 3).collect();
-        assert_eq!(masks.len(), 56);
-        // Block `n`: mask `n / 3072`, order `n / 512 % 6`, wishes `n % 512`.
-        let mut tied = 0;
-        for n in (0..56 * 6 * 512).step_by(every) {
-            let (free, order, wishes) = (masks[n / 3072], &ORDERS_3[n / 512 % 6], n % 512);
-            let cells: Vec<u8> = bits(free).map(|c| c as u8).collect();
-            let mut problem = MoveProblem { free, count: 3, ..MoveProblem::default() };
-            for i in 0..3 {
-                problem.current[i] = cells[usize::from(order[i])];
-                problem.desired[i] = (wishes >> (3 * i)) as u8 & 7;
-            }
-            let wants = &problem.desired[..3];
-            if wants.iter().enumerate().all(|(i, &w)| free >> w & 1 != 0 && !wants[..i].contains(&w)) {
-                continue;
-            }
-            let tried = targets_by_rank(3, |draw| three(&problem, free, draw));
-            let priced = targets_by_rank(3, |draw| hungarian(&problem, free, 3, draw));
-            assert_eq!(tried, priced, "{problem:?}");
-            tied += usize::from(tried.len() > 1);
-        }
-        if every == 1 {
-            assert_eq!(tied, 19_920);
-        }
-    }
-
     #[test]
     fn particle_that_gains_nothing_stays() {
         // Expect (cost2 rule, M5.6): a lone particle wanting its own cell
@@ -2155,4 +1960,3 @@ mod tests {
         }
     }
 }
-
