@@ -257,11 +257,7 @@ impl Partition {
         let mut j = 0;
         while j < total {
             let i = if reverse { band.end - 1 - j } else { band.start + j };
-            // In 2D the grid has one layer of rows of blocks (`az.blocks`
-            // is 1). With `small-step` (firmware) no division for it, which
-            // small cores call a routine for; otherwise the remainder tells
-            // the compiler `by < ay.blocks`, which spares checks below.
-            let (by, bz) = if dim == 2 && cfg!(feature = "small-step") { (i, 0) } else { (i % ay.blocks, i / ay.blocks) };
+            let (by, bz) = (i % ay.blocks, i / ay.blocks);
             let origin = [ay.first + 2 * by as isize, az.first + 2 * bz as isize];
             let (ys, y_out) = self.axis_pair(1, origin[0]);
             let (zs, z_out) = self.axis_pair(2, origin[1]);
@@ -290,13 +286,8 @@ impl Partition {
                 continue;
             }
             // An empty row of blocks: skip it, and the empty ones after it
-            // four at a time where their flags say so (with `small-step`,
-            // one at a time: less code, the same rows). Rows of blocks
-            // from i to the band's edge, i included.
-            if cfg!(feature = "small-step") {
-                j += 1;
-                continue;
-            }
+            // four at a time where their flags say so. Rows of blocks from
+            // i to the band's edge, i included.
             let room = if reverse { i - band.start + 1 } else { band.end - i };
             j += match layers {
                 1 => self.empty_run_2d(idx.rows, [by, bz], reverse, room),
