@@ -36,6 +36,12 @@ trap 'rm -rf "$out"' EXIT
 case "${1:-}" in
     --assign | --classes | --per-block) cargo build --release -q -p mpca-tests --bin assign_blocks ;;
 esac
+# `assign_blocks 3 ARG...` under callgrind, counting inside `solve` only,
+# into $out/cg; $dump, where set, is one more callgrind option.
+solve_counted() {
+    valgrind --tool=callgrind --callgrind-out-file="$out/cg" --collect-atstart=no \
+        --toggle-collect='*assign_blocks*solve*' ${dump:+"$dump"} target/release/assign_blocks 3 "$@"
+}
 
 if [ "${1:-}" = "--classes" ]; then
     blocks=4000
@@ -45,9 +51,7 @@ if [ "${1:-}" = "--classes" ]; then
     per_block() {
         local k=$1 f=$2 method=$3 solved
         shift 3
-        solved=$(valgrind --tool=callgrind --callgrind-out-file="$out/cg" --collect-atstart=no \
-            --toggle-collect='*assign_blocks*solve*' target/release/assign_blocks 3 "$k" "$method" $blocks "$f" "$@" 2>/dev/null |
-            awk '$2 == "blocks" {print $1}')
+        solved=$(solve_counted "$k" "$method" $blocks "$f" "$@" 2>/dev/null | awk '$2 == "blocks" {print $1}')
         [ -n "$solved" ] || { printf -- -; return; }
         awk -v n="$solved" '/^(summary|totals):/{printf "%.0f", $2 / n; exit}' "$out/cg"
     }
@@ -75,9 +79,7 @@ if [ "${1:-}" = "--per-block" ]; then
         local k=$1 f=$2 method=$3 files
         shift 3
         rm -f "$out"/cg*
-        valgrind --tool=callgrind --callgrind-out-file="$out/cg" --collect-atstart=no \
-            --toggle-collect='*assign_blocks*solve*' --dump-before='assign_blocks::solve' \
-            target/release/assign_blocks 3 "$k" "$method" $blocks "$f" "$@" each >/dev/null 2>&1
+        dump=--dump-before=assign_blocks::solve solve_counted "$k" "$method" $blocks "$f" "$@" each >/dev/null 2>&1
         files=$(find "$out" -name 'cg*' | wc -l)
         [ "$files" -gt 2 ] || return 0
         for i in $(seq 2 $((files - 1))) cg; do
@@ -104,8 +106,7 @@ if [ "${1:-}" = "--assign" ]; then
     blocks=4000
     # Instructions per block of `solve` for (K, METHOD), 3D random blocks.
     per_block() {
-        valgrind --tool=callgrind --callgrind-out-file="$out/cg" --collect-atstart=no \
-            --toggle-collect='*assign_blocks*solve*' target/release/assign_blocks 3 "$1" "$2" $blocks >/dev/null 2>&1
+        solve_counted "$1" "$2" $blocks >/dev/null 2>&1
         awk -v n=$blocks '/^(summary|totals):/{printf "%.0f", $2 / n; exit}' "$out/cg"
     }
     printf '%-10s %12s %12s %8s\n' particles exact-fast greedy ratio
