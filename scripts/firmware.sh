@@ -47,6 +47,8 @@ ENFORCE_RODATA=1
 need=()
 command -v arm-none-eabi-gcc >/dev/null || need+=(gcc-arm-none-eabi)
 command -v qemu-system-arm >/dev/null || need+=(qemu-system-arm)
+# newlib-nano, the C library of the Arm embedded toolchain's small builds.
+arm-none-eabi-gcc -print-file-name=libc_nano.a 2>/dev/null | grep -q / || need+=(libnewlib-arm-none-eabi)
 scripts/install-missing.sh ${need[@]+"${need[@]}"}
 for t in thumbv6m-none-eabi thumbv7em-none-eabihf; do
     rustup target list --installed | grep -qx "$t" || rustup target add "$t"
@@ -126,10 +128,18 @@ for variant in "${variants[@]}"; do
             arm-none-eabi-gcc $(cpu_flags $core) -std=c11 -Wall -Wextra -Wpedantic -Werror -Os -ffreestanding \
                 -ffunction-sections -fdata-sections -Iinclude -c "$src/$f.c" -o "$dir/$f.o"
         done
+        # memcpy and memset from the C library, newlib-nano, as a C firmware
+        # links them: libmpca.a carries the Rust runtime's own copies
+        # (compiler_builtins, some 1 KB on the M0), which the linker would
+        # take first, finding them in the archive that asks for them. Naming
+        # the AEABI entries as undefined before the C library is searched
+        # takes newlib's (their members also define the 4- and 8-byte
+        # aligned variants).
         # shellcheck disable=SC2046
         arm-none-eabi-gcc $(cpu_flags $core) -nostdlib -Wl,--gc-sections -Wl,--no-warn-execstack \
             -L"$src" -T "$(board $core).ld" -Wl,-Map,"$dir/smoke64.map" -o "$dir/smoke64.elf" \
-            "$dir/smoke64.o" "$dir/startup.o" "$dir/semihosting.o" "$dir/libmpca.a" -lgcc
+            "$dir/smoke64.o" "$dir/startup.o" "$dir/semihosting.o" \
+            -Wl,--undefined=__aeabi_memcpy,--undefined=__aeabi_memclr -lc_nano "$dir/libmpca.a" -lgcc
         arm-none-eabi-size -A "$dir/smoke64.elf" > "$dir/size.txt"
 
         begin=$(arm-none-eabi-nm "$dir/smoke64.elf" | awk '$3 == "mark_begin" {print "0x" $1}')
