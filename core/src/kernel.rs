@@ -45,7 +45,7 @@ use crate::collision::{collide_limited, collide_pair, energy_neutral, pick_pair,
 use crate::desc::{Collisions, Description};
 use crate::force::{Flow, ForceTerms};
 use crate::obstacle::{reflect, surface_at, Surface};
-use crate::partition::{cells_at, resolve, BlockRow, BlockSink, Beyond, Index, Partition};
+use crate::partition::{cells_at, resolve, BlockRow, Coords, BlockSink, Beyond, Index, Partition};
 use crate::quant::Quant;
 use crate::rng::{StepKey, Stream};
 use crate::vector::{clamp_long, dot, dot_of, normalise};
@@ -355,7 +355,7 @@ fn clamp_and_count(x: [f32; 3], s2: f32, scale: f32, m: f32, counters: &mut Coun
 struct Wanted {
     cell: usize,
     site: usize,
-    at: [i64; 3],
+    at: Coords,
     wall: bool,
 }
 
@@ -409,7 +409,7 @@ fn reflect_off<const D: usize>(sh: &Shared<'_>, x: [f32; 3], c: usize, to: Wante
         // off the face it came through. M5.4.
         let mut at = to.at;
         for (k, a) in at.iter_mut().enumerate().take(D) {
-            *a += ((c >> k) & 1) as i64 - ((t >> k) & 1) as i64;
+            *a += ((c >> k) & 1) as isize - ((t >> k) & 1) as isize;
         }
         if dot(n, back) > 0.0 && crate::obstacle::axis_move_free(if cfg!(feature = "obstacles") { sh.obstacle } else { &[] }, sh.n, &sh.desc.boundary, at, x, D) {
             return None;
@@ -1000,7 +1000,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
         // c >> 1 (y, then z).
         let (xs, x_out) = sh.part.axis_pair(0, x0);
         let cell = |c: usize| xs[c & 1] + row.cell[c >> 1];
-        let at = |c: usize| [x0 as i64 + (c & 1) as i64, row.origin[0] as i64 + ((c >> 1) & 1) as i64, row.origin[1] as i64 + ((c >> 2) & 1) as i64];
+        let at = |c: usize| [x0 + (c & 1) as isize, row.origin[0] + ((c >> 1) & 1) as isize, row.origin[1] + ((c >> 2) & 1) as isize];
         let mut outside = row.outside;
         if x_out != 0 {
             let low = if x_out & 1 != 0 { const { cells_at(0, 0, D) } } else { 0 };
@@ -1242,8 +1242,8 @@ mod tests {
                 // The block's lowest corner: -1 (across the low face) or
                 // n - 1 (across the high one) on each axis.
                 for corner in 0..cells {
-                    let origin: [i64; 3] = core::array::from_fn(|k| if k >= dim { 0 } else if corner >> k & 1 == 0 { -1 } else { n[k] as i64 - 1 });
-                    let at = |c: usize| -> [i64; 3] { core::array::from_fn(|k| if k >= dim { 0 } else { origin[k] + (c >> k & 1) as i64 }) };
+                    let origin: Coords = core::array::from_fn(|k| if k >= dim { 0 } else if corner >> k & 1 == 0 { -1 } else { n[k] as isize - 1 });
+                    let at = |c: usize| -> Coords { core::array::from_fn(|k| if k >= dim { 0 } else { origin[k] + (c >> k & 1) as isize }) };
                     for c in 0..cells {
                         if !matches!(resolve(n, &boundary, at(c)), Beyond::Inside(_)) {
                             continue;

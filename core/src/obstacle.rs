@@ -11,7 +11,7 @@
 
 use crate::cells::Cells;
 use crate::desc::{finite, restitution, Boundary};
-use crate::partition::{resolve, Beyond};
+use crate::partition::{resolve, Beyond, Coords};
 use crate::vector::{dot, normalise};
 use crate::layout::{put_bit, row_words, test_bit, Plain};
 use crate::world::World;
@@ -94,7 +94,7 @@ pub(crate) fn reflect(v: [f32; 3], n: [f32; 3], e: f32) -> [f32; 3] {
 /// `sign(v_k)`, `v_k != 0`, one of the first `dim` axes) that is neither an
 /// obstacle (bit plane `obstacle`) nor beyond a wall. Such a particle can
 /// always move on later, so refusing it one move leaves it never stuck.
-pub(crate) fn axis_move_free(obstacle: &[u64], n: [usize; 3], boundary: &[[Boundary; 2]; 3], at: [i64; 3], v: [f32; 3], dim: usize) -> bool {
+pub(crate) fn axis_move_free(obstacle: &[u64], n: [usize; 3], boundary: &[[Boundary; 2]; 3], at: Coords, v: [f32; 3], dim: usize) -> bool {
     (0..dim).any(|k| {
         if v[k] == 0.0 {
             return false;
@@ -255,7 +255,7 @@ fn centre(c: [usize; 3]) -> [f32; 3] {
 impl World {
     /// The neighbour of `c` at offset `off`, after the boundary rules (M4).
     fn beyond(&self, c: [usize; 3], off: [i32; 3]) -> Beyond {
-        let at = [0, 1, 2].map(|k| c[k] as i64 + i64::from(off[k]));
+        let at = [0, 1, 2].map(|k| c[k] as isize + off[k] as isize);
         resolve(self.layout().n, &self.head.desc.boundary, at)
     }
 

@@ -36,18 +36,26 @@ pub(crate) enum Beyond {
     Open,
 }
 
+/// A cell's coordinates, possibly beyond a face: signed machine words,
+/// wide enough for the `-n <= c < 2n` that [`resolve`] takes. On 32-bit
+/// cores `Layout::of` keeps a world's bytes below 2^30 and every cell holds
+/// at least two bytes of velocity, so no axis reaches 2^29 cells and `2n`
+/// fits an `i32`; 64-bit integers would be pairs of registers there, and
+/// library calls.
+pub(crate) type Coords = [isize; 3];
+
 /// M4: what lies at the (possibly out-of-domain) cell coordinates `c` of a
 /// domain of `n` cells per axis with faces `boundary`. Axes beyond the
 /// world's dimension have `n = 1` and `c = 0`. Every caller asks for a
 /// neighbour of a cell, so each coordinate lies within one domain length
 /// of the domain (`-n <= c < 2n`): a periodic face wraps it with one add
 /// (no 64-bit division, which small cores call a library routine for).
-pub(crate) fn resolve(n: [usize; 3], boundary: &[[Boundary; 2]; 3], c: [i64; 3]) -> Beyond {
+pub(crate) fn resolve(n: [usize; 3], boundary: &[[Boundary; 2]; 3], c: Coords) -> Beyond {
     let mut out = [0usize; 3];
     let mut wall = [0.0f32; 3];
     let (mut is_wall, mut is_open) = (false, false);
     for k in 0..3 {
-        let nk = n[k] as i64;
+        let nk = n[k] as isize;
         if (0..nk).contains(&c[k]) {
             out[k] = c[k] as usize;
             continue;
