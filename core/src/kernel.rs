@@ -545,7 +545,10 @@ impl<const D: usize, const CELLS: usize> Block<D, CELLS> {
         x
     }
 
-    #[inline(always)]
+    /// Makes `x` the velocity of the particle in cell `c`, to be rounded.
+    /// Out of line with `small-step`, as [`Block::velocity`] is.
+    #[cfg_attr(feature = "small-step", inline(never))]
+    #[cfg_attr(not(feature = "small-step"), inline(always))]
     fn set(&mut self, c: usize, x: [f32; 3]) {
         self.x[c] = x;
         self.pending |= 1 << c;
