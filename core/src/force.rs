@@ -47,7 +47,7 @@ impl ForceTerms<'_> {
         }
         let mut a = self.gravity;
         for k in 0..self.dim {
-            a[k] += f[k] / m;
+            a[k] += crate::vector::div(f[k], m);
         }
         a
     }
@@ -125,7 +125,7 @@ pub(crate) fn vortex_force(v: &Vortex, p: [f32; 2]) -> [f32; 2] {
     let dy = p[1] - v.centre[1];
     // Neither is NaN: squares of finite numbers (Layout::of, set_vortex).
     let r2 = crate::vector::larger(dx * dx + dy * dy, v.core_radius * v.core_radius);
-    let s = v.circulation / (core::f32::consts::TAU * r2);
+    let s = crate::vector::div(v.circulation, core::f32::consts::TAU * r2);
     let along = |d: f32| if d == 0.0 { 0.0 } else { d * s };
     [-along(dy), along(dx)]
 }

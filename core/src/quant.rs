@@ -203,7 +203,7 @@ impl Quant for i16 {
         let a = q.unsigned_abs().min(32767) as f32 * (1.0 / Self::SCALE);
         let p = match drift {
             Drift::Paper => a,
-            Drift::Calibrated => 2.0 * a / (1.0 + a),
+            Drift::Calibrated => crate::vector::div(2.0 * a, 1.0 + a),
         };
         // 0 for q = 0 (which never moves: M5.3 asks only inward axes).
         ((p * 65536.0 + 0.5) as u32).saturating_sub(1)

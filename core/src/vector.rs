@@ -133,10 +133,112 @@ fn bitwise_sqrt(x: f32) -> f32 {
     f32::from_bits((((k / 2 + 127) as u32) << 23) + (root - 0x80_0000))
 }
 
+/// `a / b`, correctly rounded as IEEE 754 asks. On Arm cores without a
+/// floating-point unit [`bitwise_div`], some 530 bytes smaller than the
+/// Rust runtime's `__divsf3` it replaces; elsewhere the division itself
+/// (an instruction, or the runtime's routine where the core has none).
+#[inline(always)]
+pub(crate) fn div(a: f32, b: f32) -> f32 {
+    #[cfg(all(target_arch = "arm", not(target_abi = "eabihf")))]
+    {
+        bitwise_div(a, b)
+    }
+    #[cfg(not(all(target_arch = "arm", not(target_abi = "eabihf"))))]
+    {
+        a / b
+    }
+}
+
+/// `a / b` by long division of the significands in 32-bit integers,
+/// correctly rounded (to nearest, ties to even): for Arm cores without a
+/// floating-point unit, where the runtime's `__divsf3` takes some 530
+/// bytes and multiplies in 64 bits (itself a library call there).
+///
+/// Every IEEE case comes out as the division gives it: a NaN operand comes
+/// back quieted (the first one where both are NaN, as x86-64 and the
+/// runtime's routine pick), `0 / 0` and `inf / inf` are `f32::NAN`,
+/// `x / 0` and `inf / x` signed infinities, `0 / x` and `x / inf` signed
+/// zeros; subnormal operands and results, and overflow to infinity, are
+/// rounded as any other. The tests hold it to the division bit for bit.
+#[cfg_attr(not(all(target_arch = "arm", not(target_abi = "eabihf"))), allow(dead_code))]
+fn bitwise_div(a: f32, b: f32) -> f32 {
+    const INF: u32 = 0x7f80_0000;
+    let (x, y) = (a.to_bits(), b.to_bits());
+    let sign = (x ^ y) & 0x8000_0000;
+    let (ax, ay) = (x & 0x7fff_ffff, y & 0x7fff_ffff);
+    if ax > INF || ay > INF {
+        // A NaN operand, quieted: the first where both are.
+        return f32::from_bits(if ax > INF { x } else { y } | 0x40_0000);
+    }
+    if ax == INF || ay == 0 {
+        // inf / inf and 0 / 0 are NaN; x / 0 and inf / x infinite.
+        return if ax == ay { f32::NAN } else { f32::from_bits(sign | INF) };
+    }
+    if ax == 0 || ay == INF {
+        return f32::from_bits(sign); // 0 / x, x / inf
+    }
+    // Each operand as m 2^(f - 150), f its exponent field: m its 23 bits
+    // and the implicit top one at bit 23 (the bits less the field plus 1);
+    // a subnormal (field 0) is its bits, scaled as field 1.
+    let unpack = |bits: u32| {
+        let f = (bits >> 23).max(1);
+        (bits - ((f - 1) << 23), f as i32)
+    };
+    let (mut ma, fa) = unpack(ax);
+    let (mut mb, fb) = unpack(ay);
+    // The quotient of the significands brought to [1, 2), that is mb <= ma
+    // < 2 mb, doubling the smaller (a subnormal's may take 23 doublings),
+    // with e the result's biased exponent: ma stays below 2^25, mb below
+    // 2^24.
+    let mut e = fa - fb + 127;
+    while ma < mb {
+        ma <<= 1;
+        e -= 1;
+    }
+    while ma >= mb << 1 {
+        mb <<= 1;
+        e += 1;
+    }
+    if e >= 255 {
+        return f32::from_bits(sign | INF);
+    }
+    // 26 bits of ma / mb (in [2^25, 2^26)): the 24 of the significand, a
+    // rounding bit and one more, a bit at a time, the first (always 1)
+    // marking how many have been taken; the remainder stays below 2 mb,
+    // under 2^25. A remainder left over sets the lowest bit (sticky): the
+    // quotient was not exact.
+    let (mut q, mut rest) = (1u32, ma - mb);
+    while q < 1 << 25 {
+        q <<= 1;
+        rest <<= 1;
+        if rest >= mb {
+            rest -= mb;
+            q |= 1;
+        }
+    }
+    q |= u32::from(rest != 0);
+    // Below the normal range: the significand shifted right to the
+    // subnormals' fixed exponent (field 0, scaled as field 1), a bit at a
+    // time, each bit shifted out kept in the lowest (sticky) bit.
+    while e < 1 {
+        q = q >> 1 | q & 1;
+        e += 1;
+    }
+    // To nearest, ties to even: adding 1, and 1 more where the last kept
+    // bit is odd, carries into it exactly where the two bits below are 11,
+    // or 10 after an odd bit.
+    let q = (q + 1 + (q >> 2 & 1)) >> 2;
+    // The significand's top bit adds 1 to the exponent field e - 1, and a
+    // rounding that carries to 2^24 one more (up to infinity's field 255);
+    // a subnormal has no top bit and stays at field 0, or reaches the
+    // smallest normal number when it rounds up to 2^23.
+    f32::from_bits(sign | ((((e - 1) as u32) << 23) + q))
+}
+
 /// `v / |v|`, or `None` where the length is zero or not finite.
 pub(crate) fn normalise(v: [f32; 3]) -> Option<[f32; 3]> {
     let len = sqrt(dot(v, v));
-    (len.is_finite() && len > 1e-6).then(|| [v[0] / len, v[1] / len, v[2] / len])
+    (len.is_finite() && len > 1e-6).then(|| [div(v[0], len), div(v[1], len), div(v[2], len)])
 }
 
 /// M5.5: scales `v` back to `|v| = limit` if it is longer, returning the
@@ -174,7 +276,7 @@ pub(crate) fn clamp_long(mut v: [f32; 3], s2: f32, limit: f32) -> ([f32; 3], f32
     if !s2.is_finite() {
         // In units of the limit, so that "short enough" means length <= 1.
         for c in v.iter_mut() {
-            *c /= limit;
+            *c = div(*c, limit);
         }
         let big = v.iter().filter(|c| !c.is_nan()).fold(0.0f32, |b, c| larger(b, c.abs()));
         for c in v.iter_mut() {
@@ -183,7 +285,7 @@ pub(crate) fn clamp_long(mut v: [f32; 3], s2: f32, limit: f32) -> ([f32; 3], f32
             } else if big.is_infinite() {
                 if c.is_infinite() { c.signum() } else { 0.0 }
             } else if big > 1.0 {
-                *c / big
+                div(*c, big)
             } else {
                 // Only a NaN made the length undefined; what is left is
                 // already short enough and keeps its size.
@@ -196,7 +298,7 @@ pub(crate) fn clamp_long(mut v: [f32; 3], s2: f32, limit: f32) -> ([f32; 3], f32
         }
         return (*v, f32::INFINITY);
     }
-    let scale = limit / sqrt(s2);
+    let scale = div(limit, sqrt(s2));
     for c in v.iter_mut() {
         *c *= scale;
     }
@@ -227,6 +329,96 @@ mod tests {
         check(f32::INFINITY);
         check(-0.0);
         assert!(bitwise_sqrt(-1.0).is_nan() && bitwise_sqrt(f32::NAN).is_nan() && bitwise_sqrt(-f32::MIN_POSITIVE).is_nan());
+    }
+
+    #[test]
+    fn bitwise_div_is_the_division() {
+        // Expect: the hardware's `a / b` bit for bit wherever it is a
+        // number; where it is NaN, a NaN, and the one the runtime's
+        // `__divsf3` (which `bitwise_div` replaces) gives: the first NaN
+        // operand quieted, else `f32::NAN` (0 / 0, inf / inf). Operands:
+        // every pair of special values, the edges of every exponent pair,
+        // quotients at the underflow and overflow boundaries, random bits.
+        let check = |a: f32, b: f32| {
+            let (a, b) = (core::hint::black_box(a), core::hint::black_box(b));
+            let (got, want) = (bitwise_div(a, b), a / b);
+            if want.is_nan() {
+                let runtime = if a.is_nan() { a.to_bits() | 0x40_0000 } else if b.is_nan() { b.to_bits() | 0x40_0000 } else { f32::NAN.to_bits() };
+                assert_eq!(got.to_bits(), runtime, "{a:e} / {b:e} ({:#x} / {:#x})", a.to_bits(), b.to_bits());
+            } else {
+                assert_eq!(got.to_bits(), want.to_bits(), "{a:e} / {b:e} ({:#x} / {:#x})", a.to_bits(), b.to_bits());
+            }
+        };
+        let specials = [
+            0.0,
+            f32::INFINITY,
+            f32::NAN,
+            f32::from_bits(0x7f80_0001), // signalling
+            f32::from_bits(0x7fa5_a5a5), // signalling, with a payload
+            f32::from_bits(0x7fc1_2345), // quiet, with a payload
+            f32::from_bits(1),           // the smallest subnormal
+            f32::from_bits(0x7f_ffff),   // the largest
+            f32::from_bits(0x40_0000),
+            f32::MIN_POSITIVE,
+            f32::MAX,
+            1.0,
+            1.5,
+            3.0,
+            f32::EPSILON,
+            1.0 - f32::EPSILON / 2.0,
+        ];
+        for a in specials {
+            for b in specials {
+                for (sa, sb) in [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)] {
+                    check(a.copysign(sa), b.copysign(sb));
+                }
+            }
+        }
+        // Both exponents' edges: every pair of exponent fields (0 the
+        // subnormals, 255 infinity and NaN) with the smallest and largest
+        // significands, and every 16th pair with a few more.
+        let edges = [0u32, 1, 2, 0x40_0000, 0x7f_fffe, 0x7f_ffff];
+        // (Every 17th field under Miri: 0, 17, ..., 255.)
+        for ea in (0..256u32).step_by(crate::sized(1, 17)) {
+            for eb in (0..256u32).step_by(crate::sized(1, 17)) {
+                let some = if (ea ^ eb) % 16 == 0 { &edges[..] } else { &edges[..1] };
+                for &ka in some.iter().chain(&edges[5..]) {
+                    for &kb in some.iter().chain(&edges[5..]) {
+                        check(f32::from_bits(ea << 23 | ka), f32::from_bits(0x8000_0000 | eb << 23 | kb));
+                    }
+                }
+            }
+        }
+        let mut bits = 0x2545_f491u32;
+        let mut next = || {
+            bits ^= bits << 13;
+            bits ^= bits >> 17;
+            bits ^= bits << 5;
+            bits
+        };
+        // Quotients next to the boundaries: a random divisor b and a
+        // dividend r b for r about the smallest subnormal, the largest
+        // subnormal, the smallest normal and the largest finite number (or
+        // beyond it), each nudged by a few ulps.
+        for _ in 0..crate::sized(20_000, 200) {
+            let b = f32::from_bits(next() & 0x7fff_ffff).clamp(f32::from_bits(1), f32::MAX);
+            for r in [f32::from_bits(1), f32::from_bits(3), f32::from_bits(0x7f_ffff), f32::MIN_POSITIVE, f32::MAX] {
+                let a = (f64::from(r) * f64::from(b)) as f32;
+                if a.is_finite() {
+                    for k in 0..5u32 {
+                        check(f32::from_bits((a.to_bits() + k).saturating_sub(2)), b);
+                    }
+                }
+            }
+        }
+        // Random bit patterns: all signs, every exponent, NaNs included;
+        // then both in the normal range of nearby exponents, so that most
+        // quotients are ordinary numbers.
+        for _ in 0..crate::sized(300_000, 3_000) {
+            let (a, b) = (next(), next());
+            check(f32::from_bits(a), f32::from_bits(b));
+            check(f32::from_bits(a & 0x87ff_ffff | 0x3800_0000), f32::from_bits(b & 0x87ff_ffff | 0x3800_0000));
+        }
     }
 
     #[test]
