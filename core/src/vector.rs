@@ -99,15 +99,15 @@ fn bitwise_sqrt(x: f32) -> f32 {
     if bits > 0x7f80_0000 {
         return f32::NAN; // negative or NaN
     }
-    // x = m 2^(k - 23) with m of 24 significant bits.
-    let (mut m, mut k) = (bits & 0x7f_ffff, (bits >> 23) as i32 - 127);
-    if bits >> 23 == 0 {
-        // Subnormal: its top bit brought to bit 23.
-        let shift = m.leading_zeros() - 8;
-        m <<= shift;
-        k = -126 - shift as i32;
-    } else {
-        m |= 0x80_0000;
+    // x = m 2^(k - 23) with m of 24 significant bits: m the 23 bits and
+    // the implicit top one at bit 23 (the bits less the exponent field
+    // plus 1); a subnormal (field 0, scaled as field 1) its bits, its top
+    // bit then brought to bit 23.
+    let f = (bits >> 23).max(1);
+    let (mut m, mut k) = (bits - ((f - 1) << 23), f as i32 - 127);
+    while m < 0x80_0000 {
+        m <<= 1;
+        k -= 1;
     }
     if k & 1 != 0 {
         // An even exponent, so that it halves exactly.
@@ -115,21 +115,29 @@ fn bitwise_sqrt(x: f32) -> f32 {
         k -= 1;
     }
     // sqrt(x) = sqrt(m 2^23) 2^(k/2 - 23): the root of n = m 2^23 (below
-    // 2^48) to 24 bits, a bit at a time.
-    let mut rest = u64::from(m) << 23;
-    let (mut root, mut bit) = (0u64, 1u64 << 46);
-    while bit != 0 {
-        if rest >= root + bit {
-            rest -= root + bit;
-            root = (root >> 1) + bit;
-        } else {
-            root >>= 1;
+    // 2^48) to 24 bits, in 32-bit integers: two bits of n at a time, from
+    // the top. With r the root of the part of n taken so far and rest that
+    // part less r^2, two more bits make the part 4 times larger plus them,
+    // its remainder for the root 2r 4 rest plus them, and for 2r + 1 less
+    // (2r + 1)^2 - (2r)^2 = 4r + 1: the root gains a bit 1 where the
+    // remainder holds that, else a 0. The remainder stays at most 2r,
+    // below 2^25, and below 2^26 shifted. n's bits come from m placed at
+    // the top of a word (its 25 bits are n's top 25; the 23 below are
+    // zeros). The first two bits (m's top, at least 1) give the root's
+    // first bit, 1, which then marks how many have been taken.
+    let (mut rest, mut root, mut next) = ((m >> 23) - 1, 1u32, m << 9);
+    while root < 1 << 23 {
+        rest = rest << 2 | next >> 30;
+        next <<= 2;
+        root <<= 1;
+        if rest > root << 1 {
+            rest -= root << 1 | 1;
+            root |= 1;
         }
-        bit >>= 2;
     }
     // Nearest: up where n > (root + 1/2)^2 = root^2 + root + 1/4, that is
     // rest > root (never a tie). A root of 2^24 carries into the exponent.
-    let root = root as u32 + u32::from(rest > root);
+    let root = root + u32::from(rest > root);
     f32::from_bits((((k / 2 + 127) as u32) << 23) + (root - 0x80_0000))
 }
 
