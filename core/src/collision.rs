@@ -1,7 +1,7 @@
 //! Particle-particle collision (M5.2, eqs. 7-8).
 
 use crate::rng::Stream;
-use crate::vector::{div, dot_of, normalise};
+use crate::vector::{div, dot_of, normalise, small_to_f32};
 
 /// Cell pairs of a block, in a fixed order: `PAIRS_2D` has the C(4,2) = 6
 /// pairs of a 2D block, `PAIRS_3D` the C(8,2) = 28 of a 3D one. M5.2 picks
@@ -90,7 +90,7 @@ pub(crate) fn pick_pair<const D: usize>(occ: u8, rng: &mut Stream) -> Option<(us
 #[inline]
 pub(crate) fn random_unit<const D: usize>(rng: &mut Stream) -> [f32; 3] {
     // Bits to a coordinate in (-1, 1), symmetric about 0.
-    let coord = |b: u32| (b as f32 - 32767.5) * (1.0 / 32768.0);
+    let coord = |b: u32| (small_to_f32(b) - 32767.5) * (1.0 / 32768.0);
     loop {
         let xy = rng.bits(32);
         let z = if D == 3 { coord(rng.bits(16)) } else { 0.0 };

@@ -41,7 +41,7 @@ impl ForceTerms<'_> {
             }
         }
         if let Some(v) = self.vortex {
-            let t = vortex_force(&v, [pos[0] as f32 + 0.5, pos[1] as f32 + 0.5]);
+            let t = vortex_force(&v, centre_of(pos));
             f[0] += t[0];
             f[1] += t[1];
         }
@@ -102,12 +102,20 @@ impl Flow<'_> {
             }
         }
         if let Some(v) = self.vortex {
-            let t = vortex_force(&v, [pos[0] as f32 + 0.5, pos[1] as f32 + 0.5]);
+            let t = vortex_force(&v, centre_of(pos));
             u[0] += t[0] * self.scale;
             u[1] += t[1] * self.scale;
         }
         u
     }
+}
+
+/// The centre of cell `pos` in the plane, for [`vortex_force`]. The
+/// coordinates are below 2^31: a grid holds fewer than 2^32 cells
+/// (`Layout::of`), and each axis at least 2.
+#[inline(always)]
+fn centre_of(pos: [usize; 3]) -> [f32; 2] {
+    [crate::vector::small_to_f32(pos[0] as u32) + 0.5, crate::vector::small_to_f32(pos[1] as u32) + 0.5]
 }
 
 /// The static Rankine vortex force at point `p`: tangential, of magnitude

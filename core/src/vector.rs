@@ -243,6 +243,30 @@ fn bitwise_div(a: f32, b: f32) -> f32 {
     f32::from_bits(sign | ((((e - 1) as u32) << 23) + q))
 }
 
+/// `x as f32` for an `x` below 2^31 (random bits, grid coordinates). On
+/// Arm cores without an FPU through `i32`: the same value, as both
+/// conversions round the same integer, but the signed one is the library
+/// routine the step links anyway (`__aeabi_i2f`), where the unsigned one
+/// would add another (`__aeabi_ui2f`). Elsewhere the cast itself.
+#[inline(always)]
+pub(crate) fn small_to_f32(x: u32) -> f32 {
+    debug_assert!(x < 1 << 31);
+    #[cfg(all(target_arch = "arm", not(target_abi = "eabihf")))]
+    {
+        let mut x = x as i32;
+        // The optimiser turns a signed conversion of a value it knows to be
+        // non-negative (masked bits) back into the unsigned one; an empty
+        // `asm!` that it must assume changes `x` hides that knowledge.
+        // SAFETY: no instructions: nothing is touched.
+        unsafe { core::arch::asm!("/* {x} */", x = inout(reg) x, options(pure, nomem, nostack, preserves_flags)) };
+        x as f32
+    }
+    #[cfg(not(all(target_arch = "arm", not(target_abi = "eabihf"))))]
+    {
+        x as f32
+    }
+}
+
 /// `v / |v|`, or `None` where the length is zero or not finite.
 pub(crate) fn normalise(v: [f32; 3]) -> Option<[f32; 3]> {
     let len = sqrt(dot(v, v));
@@ -426,6 +450,31 @@ mod tests {
             let (a, b) = (next(), next());
             check(f32::from_bits(a), f32::from_bits(b));
             check(f32::from_bits(a & 0x87ff_ffff | 0x3800_0000), f32::from_bits(b & 0x87ff_ffff | 0x3800_0000));
+        }
+    }
+
+    #[test]
+    fn small_to_f32_is_the_cast() {
+        // Expect: below 2^31 the conversion through i32 (what the helper
+        // does on cores without an FPU) and the helper both give `as f32`
+        // bit for bit: every power of two's neighbours, where rounding
+        // changes, and random values.
+        let check = |x: u32| {
+            let want = core::hint::black_box(x) as f32;
+            assert_eq!((core::hint::black_box(x) as i32 as f32).to_bits(), want.to_bits(), "{x}");
+            assert_eq!(small_to_f32(x).to_bits(), want.to_bits(), "{x}");
+        };
+        for p in 0..31 {
+            for k in 0..64u32 {
+                check((1u32 << p).saturating_sub(k) & 0x7fff_ffff);
+                check(((1u32 << p) + k) & 0x7fff_ffff);
+            }
+        }
+        check(0x7fff_ffff);
+        let mut bits = 0x0f0f_1234u32;
+        for _ in 0..crate::sized(200_000, 2_000) {
+            bits = bits.wrapping_mul(0x9e37_79b9).wrapping_add(0x7f4a_7c15);
+            check(bits >> 1);
         }
     }
 
