@@ -77,14 +77,14 @@ pub(crate) trait Quant: Copy + Default + Send + crate::layout::Plain + 'static {
         if Self::SCALE < 128.0 {
             // NaN as 0, which the sum below rounds to 0: a select, not a
             // branch, so that several components round in one vector.
-            let x = if x.is_nan() { 0.0 } else { x };
+            let x = if crate::vector::is_nan(x) { 0.0 } else { x };
             let y = (x + 128.0) + crate::vector::small_to_f32(r & 0xffff) * (1.0 / 65536.0);
-            // SAFETY: x is in [-127, 127] (clamped, and not NaN), so y is
-            // finite and in [1, 256): its integer part fits an i32. (A
-            // checked cast would test for NaN and both bounds again.)
-            return unsafe { y.to_int_unchecked::<i32>() } - 128;
+            // x is in [-127, 127] (clamped, and not NaN), so y is finite
+            // and in [1, 256): its integer part fits an i32. (A checked
+            // cast would test for NaN and both bounds again.)
+            return crate::vector::whole_part(y) - 128;
         }
-        if x.is_nan() {
+        if crate::vector::is_nan(x) {
             return 0;
         }
         let x = x * 65536.0;

@@ -267,6 +267,57 @@ pub(crate) fn small_to_f32(x: u32) -> f32 {
     }
 }
 
+/// `x.is_nan()`. On Arm cores without an FPU [`bitwise_is_nan`], where
+/// the comparison is a library routine (`__aeabi_fcmpun`) that nothing
+/// else there needs; elsewhere the comparison, one instruction that
+/// vectorises.
+#[inline(always)]
+pub(crate) fn is_nan(x: f32) -> bool {
+    #[cfg(all(target_arch = "arm", not(target_abi = "eabihf")))]
+    {
+        bitwise_is_nan(x)
+    }
+    #[cfg(not(all(target_arch = "arm", not(target_abi = "eabihf"))))]
+    {
+        x.is_nan()
+    }
+}
+
+/// `x.is_nan()` from its bits: the magnitude's above infinity's.
+#[cfg_attr(not(all(target_arch = "arm", not(target_abi = "eabihf"))), allow(dead_code))]
+#[inline(always)]
+fn bitwise_is_nan(x: f32) -> bool {
+    x.to_bits() & 0x7fff_ffff > 0x7f80_0000
+}
+
+/// The integer part of a `y` in `[1, 2^24)`, `y as i32`. On Arm cores
+/// without an FPU [`bitwise_whole_part`], where the cast is a library
+/// routine (`__aeabi_f2iz`) that only the stochastic rounding of 8-bit
+/// velocities (`Quant::stochastic`) calls; elsewhere the cast.
+#[inline(always)]
+pub(crate) fn whole_part(y: f32) -> i32 {
+    debug_assert!((1.0..16_777_216.0).contains(&y));
+    #[cfg(all(target_arch = "arm", not(target_abi = "eabihf")))]
+    {
+        bitwise_whole_part(y)
+    }
+    #[cfg(not(all(target_arch = "arm", not(target_abi = "eabihf"))))]
+    {
+        // SAFETY: y is finite and below 2^31 (the caller's bound).
+        unsafe { y.to_int_unchecked::<i32>() }
+    }
+}
+
+/// The integer part of a `y` in `[1, 2^24)` from its bits: the significand
+/// with its top bit (a value in `[2^23, 2^24)`), shifted right by 23 less
+/// the exponent (150 less the exponent field; 0 to 23 places).
+#[cfg_attr(not(all(target_arch = "arm", not(target_abi = "eabihf"))), allow(dead_code))]
+#[inline(always)]
+fn bitwise_whole_part(y: f32) -> i32 {
+    let bits = y.to_bits();
+    ((bits & 0x7f_ffff | 0x80_0000) >> (150 - (bits >> 23))) as i32
+}
+
 /// `v / |v|`, or `None` where the length is zero or not finite.
 pub(crate) fn normalise(v: [f32; 3]) -> Option<[f32; 3]> {
     let len = sqrt(dot(v, v));
@@ -310,9 +361,9 @@ pub(crate) fn clamp_long(mut v: [f32; 3], s2: f32, limit: f32) -> ([f32; 3], f32
         for c in v.iter_mut() {
             *c = div(*c, limit);
         }
-        let big = v.iter().filter(|c| !c.is_nan()).fold(0.0f32, |b, c| larger(b, c.abs()));
+        let big = v.iter().filter(|c| !is_nan(**c)).fold(0.0f32, |b, c| larger(b, c.abs()));
         for c in v.iter_mut() {
-            *c = if c.is_nan() || big == 0.0 {
+            *c = if is_nan(*c) || big == 0.0 {
                 0.0
             } else if big.is_infinite() {
                 if c.is_infinite() { c.signum() } else { 0.0 }
@@ -475,6 +526,50 @@ mod tests {
         for _ in 0..crate::sized(200_000, 2_000) {
             bits = bits.wrapping_mul(0x9e37_79b9).wrapping_add(0x7f4a_7c15);
             check(bits >> 1);
+        }
+    }
+
+    #[test]
+    fn bitwise_is_nan_is_is_nan() {
+        // Expect: `is_nan` for every exponent's neighbours, both signs
+        // (zeros, subnormals, infinities, quiet and signalling NaNs) and
+        // random bit patterns.
+        let check = |x: f32| assert_eq!(bitwise_is_nan(x), x.is_nan(), "{:#x}", x.to_bits());
+        for e in 0..256u32 {
+            for k in 0..4 {
+                for sign in [0, 0x8000_0000] {
+                    check(f32::from_bits(sign | ((e << 23) + k)));
+                    check(f32::from_bits(sign | (((e << 23) | 0x7f_ffff) - k)));
+                }
+            }
+        }
+        let mut bits = 0x3c6e_f372u32;
+        for _ in 0..crate::sized(200_000, 2_000) {
+            bits = bits.wrapping_mul(0x9e37_79b9).wrapping_add(0x7f4a_7c15);
+            check(f32::from_bits(bits));
+        }
+    }
+
+    #[test]
+    fn bitwise_whole_part_is_the_cast() {
+        // Expect: `as i32` bit for bit over [1, 2^24): every exponent's
+        // first and last values and their neighbours, every value of
+        // [1, 256) on a grid of 2^-16 (what `Quant::stochastic` hands it),
+        // and random values.
+        let check = |y: f32| assert_eq!(bitwise_whole_part(y), y as i32, "{y:e} {:#x}", y.to_bits());
+        for e in 127..151u32 {
+            for k in 0..64 {
+                check(f32::from_bits((e << 23) + k));
+                check(f32::from_bits(((e << 23) | 0x7f_ffff) - k));
+            }
+        }
+        for i in (65_536..256 * 65_536).step_by(crate::sized(1, 997)) {
+            check(i as f32 * (1.0 / 65536.0));
+        }
+        let mut bits = 0x5be0_cd19u32;
+        for _ in 0..crate::sized(200_000, 2_000) {
+            bits = bits.wrapping_mul(0x9e37_79b9).wrapping_add(0x7f4a_7c15);
+            check(f32::from_bits(0x3f80_0000 + bits % (24 << 23)));
         }
     }
 
