@@ -129,11 +129,15 @@ fn bitwise_sqrt(x: f32) -> f32 {
     while root < 1 << 23 {
         rest = rest << 2 | next >> 30;
         next <<= 2;
-        root <<= 1;
-        if rest > root << 1 {
-            rest -= root << 1 | 1;
-            root |= 1;
-        }
+        // As in bitwise_div: borrow all ones where the remainder does not
+        // hold 4r + 1 (both below 2^26, so the sign bit tells), else 0;
+        // the root's next bit is 1 plus borrow, and 4r + 1 is added back
+        // where it borrowed.
+        let trial = root << 2 | 1;
+        let less = rest.wrapping_sub(trial);
+        let borrow = ((less as i32) >> 31) as u32;
+        root = (root << 1 | 1).wrapping_add(borrow);
+        rest = less.wrapping_add(trial & borrow);
     }
     // Nearest: up where n > (root + 1/2)^2 = root^2 + root + 1/4, that is
     // rest > root (never a tie). A root of 2^24 carries into the exponent.
@@ -212,17 +216,20 @@ fn bitwise_div(a: f32, b: f32) -> f32 {
     }
     // 26 bits of ma / mb (in [2^25, 2^26)): the 24 of the significand, a
     // rounding bit and one more, a bit at a time, the first (always 1)
-    // marking how many have been taken; the remainder stays below 2 mb,
-    // under 2^25. A remainder left over sets the lowest bit (sticky): the
+    // marking how many have been taken; the remainder stays below mb,
+    // under 2^24. A remainder left over sets the lowest bit (sticky): the
     // quotient was not exact.
     let (mut q, mut rest) = (1u32, ma - mb);
     while q < 1 << 25 {
-        q <<= 1;
-        rest <<= 1;
-        if rest >= mb {
-            rest -= mb;
-            q |= 1;
-        }
+        // The remainder doubled, less mb; borrow all ones where that went
+        // below zero (the doubled remainder under mb: both are below 2^25,
+        // so the sign bit tells), else 0. The quotient's next bit is 1
+        // plus borrow, and mb is added back where it borrowed. Without a
+        // branch: 12 instructions a bit on the M0 rather than 15.
+        let less = (rest << 1).wrapping_sub(mb);
+        let borrow = ((less as i32) >> 31) as u32;
+        q = (q << 1 | 1).wrapping_add(borrow);
+        rest = less.wrapping_add(mb & borrow);
     }
     q |= u32::from(rest != 0);
     // Below the normal range: the significand shifted right to the
@@ -426,7 +433,11 @@ mod tests {
             let (a, b) = (core::hint::black_box(a), core::hint::black_box(b));
             let (got, want) = (bitwise_div(a, b), a / b);
             if want.is_nan() {
-                let runtime = if a.is_nan() { a.to_bits() | 0x40_0000 } else if b.is_nan() { b.to_bits() | 0x40_0000 } else { f32::NAN.to_bits() };
+                let runtime = match (a.is_nan(), b.is_nan()) {
+                    (true, _) => a.to_bits() | 0x40_0000,
+                    (false, true) => b.to_bits() | 0x40_0000,
+                    _ => f32::NAN.to_bits(),
+                };
                 assert_eq!(got.to_bits(), runtime, "{a:e} / {b:e} ({:#x} / {:#x})", a.to_bits(), b.to_bits());
             } else {
                 assert_eq!(got.to_bits(), want.to_bits(), "{a:e} / {b:e} ({:#x} / {:#x})", a.to_bits(), b.to_bits());
