@@ -1,7 +1,7 @@
 //! Particle-particle collision (M5.2, eqs. 7-8).
 
 use crate::rng::Stream;
-use crate::vector::{dot_of, normalise};
+use crate::vector::{div, dot_of, normalise, small_to_f32};
 
 /// Cell pairs of a block, in a fixed order: `PAIRS_2D` has the C(4,2) = 6
 /// pairs of a 2D block, `PAIRS_3D` the C(8,2) = 28 of a 3D one. M5.2 picks
@@ -90,14 +90,14 @@ pub(crate) fn pick_pair<const D: usize>(occ: u8, rng: &mut Stream) -> Option<(us
 #[inline]
 pub(crate) fn random_unit<const D: usize>(rng: &mut Stream) -> [f32; 3] {
     // Bits to a coordinate in (-1, 1), symmetric about 0.
-    let coord = |b: u32| (b as f32 - 32767.5) * (1.0 / 32768.0);
+    let coord = |b: u32| (small_to_f32(b) - 32767.5) * (1.0 / 32768.0);
     loop {
         let xy = rng.bits(32);
         let z = if D == 3 { coord(rng.bits(16)) } else { 0.0 };
         let v = [coord(xy & 0xffff), coord(xy >> 16), z];
         let r2 = dot_of::<D>(v, v);
         if r2 > 1.0 / 64.0 && r2 <= 1.0 {
-            let inv = 1.0 / crate::vector::sqrt(r2);
+            let inv = div(1.0, crate::vector::sqrt(r2));
             return v.map(|c| c * inv);
         }
     }
@@ -111,10 +111,10 @@ pub(crate) fn random_unit<const D: usize>(rng: &mut Stream) -> [f32; 3] {
 pub(crate) fn shares(ma: f32, mb: f32) -> (f32, f32) {
     let total = ma + mb;
     if total.is_finite() && total > 0.0 {
-        (ma / total, mb / total)
+        (div(ma, total), div(mb, total))
     } else {
-        let ratio = mb / ma;
-        (1.0 / (1.0 + ratio), ratio / (1.0 + ratio))
+        let ratio = div(mb, ma);
+        (div(1.0, 1.0 + ratio), div(ratio, 1.0 + ratio))
     }
 }
 
@@ -186,7 +186,7 @@ pub(crate) fn energy_neutral<const D: usize>(a: [f32; 3], b: [f32; 3], (sa, sb):
     let rel = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
     let kinetic = sa * sb * dot_of::<D>(rel, rel);
     let lost = sa * gain(a) + sb * gain(b);
-    let l = if kinetic > lost { crate::vector::sqrt(1.0 - lost / kinetic) } else { 0.0 };
+    let l = if kinetic > lost { crate::vector::sqrt(1.0 - div(lost, kinetic)) } else { 0.0 };
     let mut out = (a, b);
     for k in 0..D {
         let v0 = sa * a[k] + sb * b[k];

@@ -41,13 +41,13 @@ impl ForceTerms<'_> {
             }
         }
         if let Some(v) = self.vortex {
-            let t = vortex_force(&v, [pos[0] as f32 + 0.5, pos[1] as f32 + 0.5]);
+            let t = vortex_force(&v, centre_of(pos));
             f[0] += t[0];
             f[1] += t[1];
         }
         let mut a = self.gravity;
         for k in 0..self.dim {
-            a[k] += f[k] / m;
+            a[k] += crate::vector::div(f[k], m);
         }
         a
     }
@@ -102,12 +102,20 @@ impl Flow<'_> {
             }
         }
         if let Some(v) = self.vortex {
-            let t = vortex_force(&v, [pos[0] as f32 + 0.5, pos[1] as f32 + 0.5]);
+            let t = vortex_force(&v, centre_of(pos));
             u[0] += t[0] * self.scale;
             u[1] += t[1] * self.scale;
         }
         u
     }
+}
+
+/// The centre of cell `pos` in the plane, for [`vortex_force`]. The
+/// coordinates are below 2^31: a grid holds fewer than 2^32 cells
+/// (`Layout::of`), and each axis at least 2.
+#[inline(always)]
+fn centre_of(pos: [usize; 3]) -> [f32; 2] {
+    [crate::vector::small_to_f32(pos[0] as u32) + 0.5, crate::vector::small_to_f32(pos[1] as u32) + 0.5]
 }
 
 /// The static Rankine vortex force at point `p`: tangential, of magnitude
@@ -125,7 +133,7 @@ pub(crate) fn vortex_force(v: &Vortex, p: [f32; 2]) -> [f32; 2] {
     let dy = p[1] - v.centre[1];
     // Neither is NaN: squares of finite numbers (Layout::of, set_vortex).
     let r2 = crate::vector::larger(dx * dx + dy * dy, v.core_radius * v.core_radius);
-    let s = v.circulation / (core::f32::consts::TAU * r2);
+    let s = crate::vector::div(v.circulation, core::f32::consts::TAU * r2);
     let along = |d: f32| if d == 0.0 { 0.0 } else { d * s };
     [-along(dy), along(dx)]
 }

@@ -339,7 +339,7 @@ fn clamp_counted<const D: usize>(x: &mut [f32; 3], scale: f32, m: f32, counters:
 #[inline(never)]
 fn clamp_and_count(x: [f32; 3], s2: f32, scale: f32, m: f32, counters: &mut Counters) -> [f32; 3] {
     let (x, s2) = clamp_long(x, s2, scale);
-    let s2 = s2 / (scale * scale);
+    let s2 = crate::vector::div(s2, scale * scale);
     counters.clamps += 1;
     // f32 and a saturating cast: no f64 or 128-bit arithmetic, which small
     // cores emulate; f32's 24 bits are far finer than the statistic needs.
@@ -1071,7 +1071,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
                 let u = flow.at(sh.part.cell_coords(row, [xs[c & 1], 0, 0], c), cell(c));
                 let mut x = b.velocity(c);
                 for k in 0..D {
-                    x[k] = (x[k] + a * u[k]) / (1.0 + a);
+                    x[k] = crate::vector::div(x[k] + a * u[k], 1.0 + a);
                 }
                 clamp_counted::<D>(&mut x, Q::SCALE, mass_of(c), &mut self.counters);
                 b.set(c, x);

@@ -77,14 +77,14 @@ pub(crate) trait Quant: Copy + Default + Send + crate::layout::Plain + 'static {
         if Self::SCALE < 128.0 {
             // NaN as 0, which the sum below rounds to 0: a select, not a
             // branch, so that several components round in one vector.
-            let x = if x.is_nan() { 0.0 } else { x };
-            let y = (x + 128.0) + (r & 0xffff) as f32 * (1.0 / 65536.0);
-            // SAFETY: x is in [-127, 127] (clamped, and not NaN), so y is
-            // finite and in [1, 256): its integer part fits an i32. (A
-            // checked cast would test for NaN and both bounds again.)
-            return unsafe { y.to_int_unchecked::<i32>() } - 128;
+            let x = if crate::vector::is_nan(x) { 0.0 } else { x };
+            let y = (x + 128.0) + crate::vector::small_to_f32(r & 0xffff) * (1.0 / 65536.0);
+            // x is in [-127, 127] (clamped, and not NaN), so y is finite
+            // and in [1, 256): its integer part fits an i32. (A checked
+            // cast would test for NaN and both bounds again.)
+            return crate::vector::whole_part(y) - 128;
         }
-        if x.is_nan() {
+        if crate::vector::is_nan(x) {
             return 0;
         }
         let x = x * 65536.0;
@@ -200,10 +200,10 @@ impl Quant for i16 {
     fn move_limit(_: &[u16; 256], drift: Drift, q: i32) -> u32 {
         // 32,768 thresholds would not fit a table; f32 holds a/32767 to
         // 2^-24, far finer than the 2^-16 steps of the threshold.
-        let a = q.unsigned_abs().min(32767) as f32 * (1.0 / Self::SCALE);
+        let a = crate::vector::small_to_f32(q.unsigned_abs().min(32767)) * (1.0 / Self::SCALE);
         let p = match drift {
             Drift::Paper => a,
-            Drift::Calibrated => 2.0 * a / (1.0 + a),
+            Drift::Calibrated => crate::vector::div(2.0 * a, 1.0 + a),
         };
         // 0 for q = 0 (which never moves: M5.3 asks only inward axes).
         ((p * 65536.0 + 0.5) as u32).saturating_sub(1)
