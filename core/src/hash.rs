@@ -19,7 +19,7 @@ impl World {
         for (_, cell) in self.occupied_cells() {
             h.eat(&(cell as u64).to_le_bytes());
             with_quant!(self.head.desc.quantization, Q => {
-                let plane: &[Q] = self.plane(l.velocity);
+                let plane: &[Q] = self.plane(l.velocity());
                 for k in 0..d {
                     h.eat(&plane[cell * d + k].to_int().to_le_bytes());
                 }

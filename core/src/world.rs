@@ -225,19 +225,19 @@ impl World {
         // stands for it.
         let (obstacles, mass, fields) = (cfg!(feature = "obstacles"), cfg!(feature = "mass"), cfg!(feature = "fields"));
         let planes = Planes {
-            occupancy: view(take(l.occupancy)),
-            rows: take(l.rows),
-            words: view(take(l.words)),
-            obstacle: if obstacles { view(take(l.obstacle)) } else { &mut [] },
-            velocity: view(take(l.velocity)),
-            mass_index: if mass { take(l.mass_index) } else { &mut [] },
-            life: view(take(l.life)),
-            field: if fields { view(take(l.field)) } else { &mut [] },
-            potential: if fields { view(take(l.potential)) } else { &mut [] },
-            wind: if fields { view(take(l.wind)) } else { &mut [] },
-            mass_table: if mass { view(take(l.mass_table)) } else { &mut [] },
-            surface: if obstacles { view(take(l.surface)) } else { &mut [] },
-            emitters: view_counted(take(l.emitters), self.head.desc.emitter_capacity as usize),
+            occupancy: view(take(l.occupancy())),
+            rows: take(l.rows()),
+            words: view(take(l.words())),
+            obstacle: if obstacles { view(take(l.obstacle())) } else { &mut [] },
+            velocity: view(take(l.velocity())),
+            mass_index: if mass { take(l.mass_index()) } else { &mut [] },
+            life: view(take(l.life())),
+            field: if fields { view(take(l.field())) } else { &mut [] },
+            potential: if fields { view(take(l.potential())) } else { &mut [] },
+            wind: if fields { view(take(l.wind())) } else { &mut [] },
+            mass_table: if mass { view(take(l.mass_table())) } else { &mut [] },
+            surface: if obstacles { view(take(l.surface())) } else { &mut [] },
+            emitters: view_counted(take(l.emitters()), self.head.desc.emitter_capacity as usize),
         };
         (&mut self.head, planes)
     }
@@ -267,12 +267,12 @@ impl World {
     }
 
     pub(crate) fn occupied(&self, s: Site) -> bool {
-        test_bit(self.plane(self.layout().occupancy), s.bit)
+        test_bit(self.plane(self.layout().occupancy()), s.bit)
     }
 
     /// Whether cell `s` is an obstacle: never in a build without obstacles.
     pub(crate) fn is_obstacle(&self, s: Site) -> bool {
-        cfg!(feature = "obstacles") && test_bit(self.plane(self.layout().obstacle), s.bit)
+        cfg!(feature = "obstacles") && test_bit(self.plane(self.layout().obstacle()), s.bit)
     }
 }
 
