@@ -105,7 +105,10 @@ impl World {
     /// the first [`WORLD_ALIGN`]-aligned byte). The description is checked in
     /// full before a byte of `memory` is written.
     pub fn init<'a>(desc: &Description, memory: &'a mut [u8]) -> Result<&'a mut World, Error> {
-        let layout = Layout::of(desc)?;
+        // Read inside the result: moved out, the layout would be copied
+        // once more before its copy into the header.
+        let layout = Layout::of(desc);
+        let layout = layout.as_ref().map_err(|&e| e)?;
         let pad = (memory.as_ptr() as usize).wrapping_neg() & (WORLD_ALIGN - 1);
         let need = pad.checked_add(size_of::<Header>()).and_then(|n| n.checked_add(layout.total)).ok_or(Error::TooLarge)?;
         if memory.len() < need {
@@ -130,7 +133,7 @@ impl World {
             core::ptr::addr_of_mut!((*h).tag).write(TAG ^ base as u64);
             core::ptr::addr_of_mut!((*h).len).write(layout.total);
             core::ptr::addr_of_mut!((*h).desc).write(*desc);
-            core::ptr::addr_of_mut!((*h).layout).write(layout);
+            core::ptr::addr_of_mut!((*h).layout).write(*layout);
             let world = core::ptr::slice_from_raw_parts_mut(base, layout.total) as *mut World;
             let world = &mut *world;
             if world.head.desc.dim == 2 {
