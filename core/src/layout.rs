@@ -88,10 +88,16 @@ pub(crate) fn view_counted_ref<T: Plain>(bytes: &[u8], count: usize) -> &[T] {
     unsafe { core::slice::from_raw_parts(bytes.as_ptr().cast::<T>(), count) }
 }
 
-/// Whether `count` values of `T` fit in `len` bytes.
+/// Whether `count` values of `T` fit in `len` bytes, `len` no more than
+/// `isize::MAX` (a slice's). Without a checked multiplication, which small
+/// cores make with a 64-bit library call: with `2^k <= size < 2^(k+1)`, a
+/// `count` of at most `len >> k` (else too many) is below `2 len / size`,
+/// so `count * size` stays below `2 len`, which fits a usize.
 #[inline]
 fn fits<T>(len: usize, count: usize) -> bool {
-    count.checked_mul(size_of::<T>()).is_some_and(|n| n <= len)
+    let size = size_of::<T>();
+    debug_assert!(len <= isize::MAX as usize);
+    size == 0 || count <= len >> size.ilog2() && count * size <= len
 }
 
 /// Where one plane lies in the world's memory, in bytes from its start.
