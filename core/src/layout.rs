@@ -251,9 +251,9 @@ impl Layout {
         }
         let rows = n[1] * n[2];
         let row_words = row_words(n[0]);
-        let bit_plane = mul(mul(row_words, rows)?, 8)?;
-        // Bit planes are indexed by bit, so their bit count must fit too.
-        mul(bit_plane, 8)?;
+        // Bit planes are indexed by bit, so their bit count must fit too
+        // (and with it their byte count, an eighth of it).
+        let bit_plane = mul(mul(row_words, rows)?, 64)? / 8;
         let q = match d.quantization {
             Quantization::Bits8 => 1,
             Quantization::Bits16 => 2,
