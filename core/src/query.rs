@@ -349,7 +349,12 @@ impl Iterator for Occupied<'_> {
             }
             self.word += 1;
         }
-        let b = self.bits.trailing_zeros() as usize;
+        // The lowest set bit's index, as 63 less the leading zeros of that
+        // bit alone: where a core counts neither (the Cortex-M0), calls of
+        // the library's count of leading zeros, which its soft float
+        // (addition, multiplication, division) links anyway, not a table
+        // of trailing zeros of its own.
+        let b = 63 - (self.bits & self.bits.wrapping_neg()).leading_zeros() as usize;
         self.bits &= self.bits - 1;
         let x = (self.word - 1 - self.row_start) * 64 + b;
         // A build without 3D has one layer: the row is y.
