@@ -27,16 +27,22 @@ _Noreturn void sh_exit(int status) {
     }
 }
 
-static void put(sh_line *line, char c) {
+/* The line being assembled. */
+static struct {
+    char text[96];
+    size_t len;
+} line;
+
+static void put(char c) {
     /* One byte stays free for the NUL; a longer line is cut, not overrun. */
-    if (line->len + 1 < sizeof line->text) line->text[line->len++] = c;
+    if (line.len + 1 < sizeof line.text) line.text[line.len++] = c;
 }
 
-void sh_str(sh_line *line, const char *text) {
-    while (*text) put(line, *text++);
+void sh_str(const char *text) {
+    while (*text) put(*text++);
 }
 
-void sh_dec(sh_line *line, uint32_t value) {
+void sh_dec(uint32_t value) {
     /* Digit by digit from the highest power of ten, each by subtraction:
      * no division, which the Cortex-M0 has no instruction for (it would
      * link a division routine for this alone). */
@@ -50,17 +56,17 @@ void sh_dec(sh_line *line, uint32_t value) {
         }
         /* Leading zeros left out; 0 itself is one digit. */
         started |= digit != '0' || powers[i] == 1;
-        if (started) put(line, digit);
+        if (started) put(digit);
     }
 }
 
-void sh_hex64(sh_line *line, uint64_t value) {
-    for (int shift = 60; shift >= 0; shift -= 4) put(line, "0123456789abcdef"[(value >> shift) & 0xf]);
+void sh_hex64(uint64_t value) {
+    for (int shift = 60; shift >= 0; shift -= 4) put("0123456789abcdef"[(value >> shift) & 0xf]);
 }
 
-void sh_flush(sh_line *line) {
-    put(line, '\n');
-    line->text[line->len] = '\0';
-    sh_write0(line->text);
-    line->len = 0;
+void sh_flush(void) {
+    put('\n');
+    line.text[line.len] = '\0';
+    sh_write0(line.text);
+    line.len = 0;
 }

@@ -17,16 +17,13 @@ void sh_write0(const char *text);
  * else with 1 (32-bit semihosting passes a reason, not a number). */
 _Noreturn void sh_exit(int status);
 
-/* A line assembled without printf, then written with sh_write0. */
-typedef struct sh_line {
-    char text[96];
-    size_t len;
-} sh_line;
-
-void sh_str(sh_line *line, const char *text);
-void sh_dec(sh_line *line, uint32_t value);
-void sh_hex64(sh_line *line, uint64_t value);
+/* One line, assembled without printf in a buffer of semihosting.c, then
+ * written with sh_write0. One buffer for the whole program: no pointer to
+ * it to pass with every call. */
+void sh_str(const char *text);
+void sh_dec(uint32_t value);
+void sh_hex64(uint64_t value);
 /* Appends a newline, writes the line and empties it. */
-void sh_flush(sh_line *line);
+void sh_flush(void);
 
 #endif

@@ -195,7 +195,7 @@ impl World {
 
     /// The emitter table, as long as its capacity.
     fn slots(&self) -> &[Slot] {
-        view_counted_ref(self.plane_bytes(self.layout().emitters), self.head.desc.emitter_capacity as usize)
+        view_counted_ref(self.plane_bytes(self.layout().emitters()), self.head.desc.emitter_capacity as usize)
     }
 
     /// Runs every emitter once (M6), at the start of a step.

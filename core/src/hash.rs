@@ -12,20 +12,23 @@ impl World {
         let mut h = Fnv(0xcbf2_9ce4_8422_2325);
         let d = self.dim();
         let l = self.layout();
-        h.eat(&(self.head.desc.dim).to_le_bytes());
+        // Sizes and cell indices are hashed as 64-bit values; both fit 32
+        // bits (`Layout::of` keeps the cell count within a u32), so the
+        // high four bytes are zeros.
+        h.eat(self.head.desc.dim, 4);
         for k in 0..3 {
-            h.eat(&(l.n[k] as u64).to_le_bytes());
+            h.eat(l.n[k] as u32, 8);
         }
         for (_, cell) in self.occupied_cells() {
-            h.eat(&(cell as u64).to_le_bytes());
+            h.eat(cell as u32, 8);
             with_quant!(self.head.desc.quantization, Q => {
-                let plane: &[Q] = self.plane(l.velocity);
+                let plane: &[Q] = self.plane(l.velocity());
                 for k in 0..d {
-                    h.eat(&plane[cell * d + k].to_int().to_le_bytes());
+                    h.eat(plane[cell * d + k].to_int() as u32, 4);
                 }
             });
-            h.eat(&self.mass_at(cell).to_bits().to_le_bytes());
-            h.eat(&self.life_at(cell).to_le_bytes());
+            h.eat(self.mass_at(cell).to_bits(), 4);
+            h.eat(u32::from(self.life_at(cell)), 2);
         }
         h.0
     }
@@ -34,9 +37,14 @@ impl World {
 struct Fnv(u64);
 
 impl Fnv {
-    fn eat(&mut self, bytes: &[u8]) {
-        for &b in bytes {
-            self.0 = (self.0 ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3);
+    /// Hashes the `bytes` low bytes of `v` zero-extended, little-endian
+    /// first: `v` in a register, not bytes in memory (every call a store
+    /// and two addresses on a small core), and every value hashed fits 32
+    /// bits.
+    fn eat(&mut self, mut v: u32, bytes: u32) {
+        for _ in 0..bytes {
+            self.0 = (self.0 ^ u64::from(v & 0xff)).wrapping_mul(0x0000_0100_0000_01b3);
+            v >>= 8;
         }
     }
 }

@@ -88,10 +88,16 @@ pub(crate) fn view_counted_ref<T: Plain>(bytes: &[u8], count: usize) -> &[T] {
     unsafe { core::slice::from_raw_parts(bytes.as_ptr().cast::<T>(), count) }
 }
 
-/// Whether `count` values of `T` fit in `len` bytes.
+/// Whether `count` values of `T` fit in `len` bytes, `len` no more than
+/// `isize::MAX` (a slice's). Without a checked multiplication, which small
+/// cores make with a 64-bit library call: with `2^k <= size < 2^(k+1)`, a
+/// `count` of at most `len >> k` (else too many) is below `2 len / size`,
+/// so `count * size` stays below `2 len`, which fits a usize.
 #[inline]
 fn fits<T>(len: usize, count: usize) -> bool {
-    count.checked_mul(size_of::<T>()).is_some_and(|n| n <= len)
+    let size = size_of::<T>();
+    debug_assert!(len <= isize::MAX as usize);
+    size == 0 || count <= len >> size.ilog2() && count * size <= len
 }
 
 /// Where one plane lies in the world's memory, in bytes from its start.
@@ -110,26 +116,55 @@ pub(crate) struct Layout {
     pub cells: usize,
     /// 64-bit words per x-row of a bit plane (rows are padded to whole words).
     pub row_words: usize,
-    pub occupancy: Plane,
+    /// Summary words per row in the plane `words` (see [`Layout::words`]).
+    pub summary_words: usize,
+    /// Every plane, in the order they lie in memory, read through the
+    /// accessors below (`occupancy()`, ...): one array, which
+    /// [`Layout::of`] fills in one loop. As named fields each plane was
+    /// built apart and then moved into the result, some 190 bytes of
+    /// copies on a Cortex-M0.
+    plane: [Plane; PLANES],
+    pub total: usize,
+}
+
+/// The number of planes of a [`Layout`].
+const PLANES: usize = 13;
+
+/// A getter for each plane of a [`Layout`], by its index in `plane`.
+macro_rules! planes {
+    ($($(#[$doc:meta])* $name:ident = $index:literal,)*) => {
+        impl Layout {
+            $(
+                $(#[$doc])*
+                #[inline]
+                pub(crate) fn $name(&self) -> Plane {
+                    self.plane[$index]
+                }
+            )*
+        }
+    };
+}
+
+planes! {
+    /// One bit per cell: whether it holds a particle.
+    occupancy = 0,
     /// One byte per row `y + ny z`: 0 where the row holds no particle for
     /// sure, 1 where it may hold one (the step skips rows of 0, M3).
-    pub rows: Plane,
+    rows = 1,
     /// Per row, `summary_words` words with one bit per occupancy word: 0
     /// where that word holds no particle for sure (the step skips it).
-    pub words: Plane,
-    pub summary_words: usize,
-    pub obstacle: Plane,
-    pub velocity: Plane,
-    pub mass_index: Plane,
-    pub life: Plane,
-    pub field: Plane,
-    pub potential: Plane,
+    words = 2,
+    obstacle = 3,
+    velocity = 4,
+    mass_index = 5,
+    life = 6,
+    field = 7,
+    potential = 8,
     /// The wind plane of M5.1b, `dim` `f32` per cell.
-    pub wind: Plane,
-    pub mass_table: Plane,
-    pub surface: Plane,
-    pub emitters: Plane,
-    pub total: usize,
+    wind = 9,
+    mass_table = 10,
+    surface = 11,
+    emitters = 12,
 }
 
 impl Layout {
@@ -216,9 +251,9 @@ impl Layout {
         }
         let rows = n[1] * n[2];
         let row_words = row_words(n[0]);
-        let bit_plane = mul(mul(row_words, rows)?, 8)?;
-        // Bit planes are indexed by bit, so their bit count must fit too.
-        mul(bit_plane, 8)?;
+        // Bit planes are indexed by bit, so their bit count must fit too
+        // (and with it their byte count, an eighth of it).
+        let bit_plane = mul(mul(row_words, rows)?, 64)? / 8;
         let q = match d.quantization {
             Quantization::Bits8 => 1,
             Quantization::Bits16 => 2,
@@ -243,37 +278,17 @@ impl Layout {
             mul(d.surface_capacity as usize * usize::from(d.obstacles), size_of::<crate::obstacle::Surface>())?,
             mul(d.emitter_capacity as usize, size_of::<crate::emitter::Slot>())?,
         ];
-        let mut planes = [Plane::default(); 13];
+        let mut plane = lens.map(|len| Plane { off: 0, len });
         let mut at = 0usize;
-        for (plane, len) in planes.iter_mut().zip(lens) {
-            *plane = Plane { off: at, len };
-            at = at.checked_add(len).and_then(|e| e.checked_add(7)).ok_or(Error::TooLarge)? & !7;
+        for p in &mut plane {
+            p.off = at;
+            at = at.checked_add(p.len).and_then(|e| e.checked_add(7)).ok_or(Error::TooLarge)? & !7;
             // Slices may not exceed isize::MAX bytes.
             if at > isize::MAX as usize / 2 {
                 return Err(Error::TooLarge);
             }
         }
-        let [occupancy, rows, words, obstacle, velocity, mass_index, life, field, potential, wind, mass_table, surface, emitters] = planes;
-        Ok(Layout {
-            n,
-            cells,
-            row_words,
-            occupancy,
-            rows,
-            words,
-            summary_words,
-            obstacle,
-            velocity,
-            mass_index,
-            life,
-            field,
-            potential,
-            wind,
-            mass_table,
-            surface,
-            emitters,
-            total: at,
-        })
+        Ok(Layout { n, cells, row_words, summary_words, plane, total: at })
     }
 }
 

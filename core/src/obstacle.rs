@@ -308,7 +308,7 @@ impl World {
     }
 
     fn surfaces_used(&self) -> &[Surface] {
-        &self.plane::<Surface>(self.layout().surface)[..self.head.surfaces as usize]
+        &self.plane::<Surface>(self.layout().surface())[..self.head.surfaces as usize]
     }
 
     /// Inserts or replaces the entry of `entry.cell`; the caller checked that
@@ -406,7 +406,7 @@ impl World {
                 })
             })?;
         }
-        let capacity = l.surface.len / core::mem::size_of::<Surface>();
+        let capacity = l.surface().len / core::mem::size_of::<Surface>();
         if self.head.surfaces as usize + new_entries > capacity {
             return Err(Error::SurfaceTableFull);
         }
@@ -499,7 +499,7 @@ impl World {
     /// The surface entry of the obstacle at `pos`, if it is a surface cell.
     pub fn surface(&self, pos: [u32; 3]) -> Option<Surface> {
         let s = self.locate(pos).ok()?;
-        let table: &[Surface] = self.plane(self.layout().surface);
+        let table: &[Surface] = self.plane(self.layout().surface());
         surface_at(&table[..self.head.surfaces as usize], s.cell as u32).copied()
     }
 }

@@ -101,7 +101,7 @@ impl World {
         let d = self.dim();
         let mut v = [0.0f32; 3];
         with_quant!(self.head.desc.quantization, Q => {
-            let plane: &[Q] = self.plane(self.layout().velocity);
+            let plane: &[Q] = self.plane(self.layout().velocity());
             for (k, out) in v.iter_mut().enumerate().take(d) {
                 *out = plane[cell * d + k].get();
             }
@@ -111,8 +111,8 @@ impl World {
 
     pub(crate) fn mass_at(&self, cell: usize) -> f32 {
         if self.head.desc.has_masses() {
-            let idx: &[u8] = self.plane(self.layout().mass_index);
-            let table: &[f32] = self.plane(self.layout().mass_table);
+            let idx: &[u8] = self.plane(self.layout().mass_index());
+            let table: &[f32] = self.plane(self.layout().mass_table());
             table[usize::from(idx[cell])]
         } else {
             self.head.desc.mass
@@ -121,7 +121,7 @@ impl World {
 
     /// The remaining lifetime of the particle in `cell`, 0 for none.
     pub(crate) fn life_at(&self, cell: usize) -> u16 {
-        if self.head.desc.lifetimes { self.plane::<u16>(self.layout().life)[cell] } else { 0 }
+        if self.head.desc.lifetimes { self.plane::<u16>(self.layout().life())[cell] } else { 0 }
     }
 
     pub(crate) fn particle_at(&self, pos: [u32; 3], cell: usize) -> Particle {
@@ -147,7 +147,7 @@ impl World {
 
     /// The cells holding a particle, in cell order (x fastest).
     pub(crate) fn occupied_cells(&self) -> Occupied<'_> {
-        Occupied { layout: self.layout(), words: self.plane::<u64>(self.layout().occupancy), word: 0, bits: 0, row: 0, row_start: 0 }
+        Occupied { layout: self.layout(), words: self.plane::<u64>(self.layout().occupancy()), word: 0, bits: 0, row: 0, row_start: 0 }
     }
 
     /// Fills `out` with the share of cells holding a particle in each of
@@ -178,7 +178,7 @@ impl World {
         if r[0].checked_mul(r[1]).and_then(|v| v.checked_mul(r[2])) != Some(len) {
             return Err(Error::BadResolution);
         }
-        let occ: &[u64] = self.plane(l.occupancy);
+        let occ: &[u64] = self.plane(l.occupancy());
         // In u64: i * n can overflow a 32-bit usize; the result is <= n.
         let edge = |k: usize, i: usize| (i as u64 * l.n[k] as u64 / r[k] as u64) as usize;
         let mut i = 0;
@@ -248,7 +248,7 @@ impl World {
             }
             (lo[k], hi[k]) = (min[k] as usize, max[k] as usize);
         }
-        let occ: &[u64] = self.plane(l.occupancy);
+        let occ: &[u64] = self.plane(l.occupancy());
         let mut r = RegionStats::default();
         for z in lo[2]..hi[2] {
             for y in lo[1]..hi[1] {
@@ -349,7 +349,12 @@ impl Iterator for Occupied<'_> {
             }
             self.word += 1;
         }
-        let b = self.bits.trailing_zeros() as usize;
+        // The lowest set bit's index, as 63 less the leading zeros of that
+        // bit alone: where a core counts neither (the Cortex-M0), calls of
+        // the library's count of leading zeros, which its soft float
+        // (addition, multiplication, division) links anyway, not a table
+        // of trailing zeros of its own.
+        let b = 63 - (self.bits & self.bits.wrapping_neg()).leading_zeros() as usize;
         self.bits &= self.bits - 1;
         let x = (self.word - 1 - self.row_start) * 64 + b;
         // A build without 3D has one layer: the row is y.

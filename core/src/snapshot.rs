@@ -198,7 +198,7 @@ fn width_and_scale(q: Quantization) -> (usize, i32) {
 /// Calls `f(row, x)` for every set bit of a bit plane laid out as `l`
 /// plans it, whose word `i` is `word(i)`, in cell order (x fastest).
 fn each_bit(l: &Layout, word: impl Fn(usize) -> u64, mut f: impl FnMut(usize, usize)) {
-    for i in 0..l.occupancy.len / 8 {
+    for i in 0..l.occupancy().len / 8 {
         let mut bits = word(i);
         let (row, x0) = (i / l.row_words, (i % l.row_words) * 64);
         while bits != 0 {
@@ -216,12 +216,12 @@ fn image_len(d: &Description, l: &Layout, particles: usize, masses: usize, surfa
     let per_particle = d.dim as usize * width + usize::from(d.per_particle_mass) + 2 * usize::from(d.lifetimes);
     [
         FIXED,
-        l.occupancy.len,
-        l.obstacle.len,
+        l.occupancy().len,
+        l.obstacle().len,
         particles.checked_mul(per_particle)?,
-        l.field.len,
-        l.potential.len,
-        l.wind.len,
+        l.field().len,
+        l.potential().len,
+        l.wind().len,
         masses.checked_mul(4)?,
         surfaces.checked_mul(SURFACE)?,
         emitters.checked_mul(EMITTER)?,
@@ -484,8 +484,8 @@ fn read(image: &[u8]) -> Result<Image<'_>, Error> {
     g.zeros(4)?;
     let mass_room = if desc.per_particle_mass { 1..=desc.mass_classes as usize } else { 0..=0 };
     if !mass_room.contains(&masses)
-        || surfaces > layout.surface.len / size_of::<Surface>()
-        || emitters > layout.emitters.len / size_of::<Slot>()
+        || surfaces > layout.surface().len / size_of::<Surface>()
+        || emitters > layout.emitters().len / size_of::<Slot>()
         || particles > layout.cells as u64
     {
         return Err(bad);
@@ -504,14 +504,14 @@ fn read(image: &[u8]) -> Result<Image<'_>, Error> {
         masses,
         surfaces,
         emitters,
-        occupancy: g.take(layout.occupancy.len)?,
-        obstacle: g.take(layout.obstacle.len)?,
+        occupancy: g.take(layout.occupancy().len)?,
+        obstacle: g.take(layout.obstacle().len)?,
         velocity: g.take(n * dim * width)?,
         mass_index: g.take(if desc.per_particle_mass { n } else { 0 })?,
         life: g.take(if desc.lifetimes { 2 * n } else { 0 })?,
-        field: g.take(layout.field.len)?,
-        potential: g.take(layout.potential.len)?,
-        wind: g.take(layout.wind.len)?,
+        field: g.take(layout.field().len)?,
+        potential: g.take(layout.potential().len)?,
+        wind: g.take(layout.wind().len)?,
         mass_table: g.take(4 * masses)?,
         surface: g.take(SURFACE * surfaces)?,
         emitter: g.take(EMITTER * emitters)?,
@@ -530,7 +530,7 @@ fn check(img: &Image<'_>) -> Result<(), Error> {
     // particle on an obstacle, as many particles as the counter says.
     let tail = if l.n[0] % 64 == 0 { 0 } else { u64::MAX << (l.n[0] % 64) };
     let mut count = 0u64;
-    for i in 0..l.occupancy.len / 8 {
+    for i in 0..l.occupancy().len / 8 {
         let occ = le_u64(img.occupancy, i);
         let obs = if d.obstacles { le_u64(img.obstacle, i) } else { 0 };
         if (i % l.row_words == l.row_words - 1 && (occ | obs) & tail != 0) || occ & obs != 0 {
@@ -698,7 +698,7 @@ impl World {
     /// the force and wind planes, and the used entries of the tables (M12).
     pub fn snapshot_bytes(&self) -> usize {
         let h = &self.head;
-        let occupancy: &[u64] = self.plane(h.layout.occupancy);
+        let occupancy: &[u64] = self.plane(h.layout.occupancy());
         let particles = occupancy.iter().map(|w| w.count_ones() as usize).sum();
         image_len(&h.desc, &h.layout, particles, h.masses as usize, h.surfaces as usize, h.emitters as usize).unwrap_or(usize::MAX)
     }
@@ -731,13 +731,13 @@ impl World {
         for c in [h.masses, h.surfaces, h.emitters, 0] {
             p.u32(c);
         }
-        let occupancy: &[u64] = self.plane(l.occupancy);
+        let occupancy: &[u64] = self.plane(l.occupancy());
         occupancy.iter().for_each(|&w| p.u64(w));
-        self.plane::<u64>(l.obstacle).iter().for_each(|&w| p.u64(w));
+        self.plane::<u64>(l.obstacle()).iter().for_each(|&w| p.u64(w));
         // Per particle, in cell order: velocities, mass classes, lifetimes.
         let each_particle = |f: &mut dyn FnMut(usize)| each_bit(&l, |i| occupancy[i], |row, x| f(x + l.n[0] * row));
         with_quant!(h.desc.quantization, Q => {
-            let v: &[Q] = self.plane(l.velocity);
+            let v: &[Q] = self.plane(l.velocity());
             each_particle(&mut |cell| {
                 for k in 0..dim {
                     // The low byte of an i16 is the i8 itself.
@@ -746,19 +746,19 @@ impl World {
             });
         });
         if h.desc.per_particle_mass {
-            let index: &[u8] = self.plane(l.mass_index);
+            let index: &[u8] = self.plane(l.mass_index());
             each_particle(&mut |cell| p.u8(index[cell]));
         }
         if h.desc.lifetimes {
-            let life: &[u16] = self.plane(l.life);
+            let life: &[u16] = self.plane(l.life());
             each_particle(&mut |cell| p.bytes(&life[cell].to_le_bytes()));
         }
-        self.plane::<f32>(l.field).iter().for_each(|&f| p.f32(f));
-        self.plane::<f32>(l.potential).iter().for_each(|&u| p.f32(u));
-        self.plane::<f32>(l.wind).iter().for_each(|&u| p.f32(u));
-        self.plane::<f32>(l.mass_table)[..h.masses as usize].iter().for_each(|&m| p.f32(m));
-        self.plane::<Surface>(l.surface)[..h.surfaces as usize].iter().for_each(|s| put_surface(&mut p, s));
-        self.plane::<Slot>(l.emitters)[..h.emitters as usize].iter().for_each(|s| put_slot(&mut p, s));
+        self.plane::<f32>(l.field()).iter().for_each(|&f| p.f32(f));
+        self.plane::<f32>(l.potential()).iter().for_each(|&u| p.f32(u));
+        self.plane::<f32>(l.wind()).iter().for_each(|&u| p.f32(u));
+        self.plane::<f32>(l.mass_table())[..h.masses as usize].iter().for_each(|&m| p.f32(m));
+        self.plane::<Surface>(l.surface())[..h.surfaces as usize].iter().for_each(|s| put_surface(&mut p, s));
+        self.plane::<Slot>(l.emitters())[..h.emitters as usize].iter().for_each(|s| put_slot(&mut p, s));
         let crc = crc32(&p.out[..len - CHECKSUM]);
         p.u32(crc);
         debug_assert_eq!(p.at, len);

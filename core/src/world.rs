@@ -105,7 +105,10 @@ impl World {
     /// the first [`WORLD_ALIGN`]-aligned byte). The description is checked in
     /// full before a byte of `memory` is written.
     pub fn init<'a>(desc: &Description, memory: &'a mut [u8]) -> Result<&'a mut World, Error> {
-        let layout = Layout::of(desc)?;
+        // Read inside the result: moved out, the layout would be copied
+        // once more before its copy into the header.
+        let layout = Layout::of(desc);
+        let layout = layout.as_ref().map_err(|&e| e)?;
         let pad = (memory.as_ptr() as usize).wrapping_neg() & (WORLD_ALIGN - 1);
         let need = pad.checked_add(size_of::<Header>()).and_then(|n| n.checked_add(layout.total)).ok_or(Error::TooLarge)?;
         if memory.len() < need {
@@ -130,7 +133,7 @@ impl World {
             core::ptr::addr_of_mut!((*h).tag).write(TAG ^ base as u64);
             core::ptr::addr_of_mut!((*h).len).write(layout.total);
             core::ptr::addr_of_mut!((*h).desc).write(*desc);
-            core::ptr::addr_of_mut!((*h).layout).write(layout);
+            core::ptr::addr_of_mut!((*h).layout).write(*layout);
             let world = core::ptr::slice_from_raw_parts_mut(base, layout.total) as *mut World;
             let world = &mut *world;
             if world.head.desc.dim == 2 {
@@ -225,19 +228,19 @@ impl World {
         // stands for it.
         let (obstacles, mass, fields) = (cfg!(feature = "obstacles"), cfg!(feature = "mass"), cfg!(feature = "fields"));
         let planes = Planes {
-            occupancy: view(take(l.occupancy)),
-            rows: take(l.rows),
-            words: view(take(l.words)),
-            obstacle: if obstacles { view(take(l.obstacle)) } else { &mut [] },
-            velocity: view(take(l.velocity)),
-            mass_index: if mass { take(l.mass_index) } else { &mut [] },
-            life: view(take(l.life)),
-            field: if fields { view(take(l.field)) } else { &mut [] },
-            potential: if fields { view(take(l.potential)) } else { &mut [] },
-            wind: if fields { view(take(l.wind)) } else { &mut [] },
-            mass_table: if mass { view(take(l.mass_table)) } else { &mut [] },
-            surface: if obstacles { view(take(l.surface)) } else { &mut [] },
-            emitters: view_counted(take(l.emitters), self.head.desc.emitter_capacity as usize),
+            occupancy: view(take(l.occupancy())),
+            rows: take(l.rows()),
+            words: view(take(l.words())),
+            obstacle: if obstacles { view(take(l.obstacle())) } else { &mut [] },
+            velocity: view(take(l.velocity())),
+            mass_index: if mass { take(l.mass_index()) } else { &mut [] },
+            life: view(take(l.life())),
+            field: if fields { view(take(l.field())) } else { &mut [] },
+            potential: if fields { view(take(l.potential())) } else { &mut [] },
+            wind: if fields { view(take(l.wind())) } else { &mut [] },
+            mass_table: if mass { view(take(l.mass_table())) } else { &mut [] },
+            surface: if obstacles { view(take(l.surface())) } else { &mut [] },
+            emitters: view_counted(take(l.emitters()), self.head.desc.emitter_capacity as usize),
         };
         (&mut self.head, planes)
     }
@@ -267,12 +270,12 @@ impl World {
     }
 
     pub(crate) fn occupied(&self, s: Site) -> bool {
-        test_bit(self.plane(self.layout().occupancy), s.bit)
+        test_bit(self.plane(self.layout().occupancy()), s.bit)
     }
 
     /// Whether cell `s` is an obstacle: never in a build without obstacles.
     pub(crate) fn is_obstacle(&self, s: Site) -> bool {
-        cfg!(feature = "obstacles") && test_bit(self.plane(self.layout().obstacle), s.bit)
+        cfg!(feature = "obstacles") && test_bit(self.plane(self.layout().obstacle()), s.bit)
     }
 }
 

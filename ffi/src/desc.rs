@@ -2,7 +2,7 @@
 
 use mpca_core::{Boundary, Collisions, Description, Drag, Drift, Forces, Method, Quantization, Vortex};
 
-use crate::{check_size, flag, guard, mpca_status};
+use crate::{check_size, guard, mpca_status};
 
 /// What happens at one face of the domain (M4). Values of `mpca_desc.boundary`.
 #[repr(u32)]
@@ -226,12 +226,31 @@ impl mpca_desc {
     /// here, everything else by the core's own validation.
     pub(crate) fn to_core(self) -> Result<Description, mpca_status> {
         check_size::<mpca_desc>(self.struct_size)?;
-        if self.forces & !FORCE_BITS != 0 || self.reserved != 0 {
-            return Err(mpca_status::BadEnum);
-        }
         // Every field is set below: the constant only gives the
         // non-exhaustive structure a start.
         let mut d = BASE;
+        // The flags, and the enumerations of two values, are converted as
+        // read, and all checked at the end at once: valid when none is
+        // above 1, that is when they or'ed together are at most 1 (a test
+        // and a branch of its own for each was some 20 bytes a field on a
+        // small core). `d` is a local: what a refusal leaves in it is
+        // dropped.
+        let mut ones = 0;
+        let mut one = |v: u32| {
+            ones |= v;
+            v != 0
+        };
+        d.per_particle_mass = one(self.per_particle_mass);
+        d.obstacles = one(self.obstacles);
+        d.drift = if one(self.drift) { Drift::Calibrated } else { Drift::Paper };
+        d.collisions = if one(self.collisions) { Collisions::SpeedLimited } else { Collisions::Paper };
+        d.contacts = one(self.contacts);
+        d.energy_neutral = one(self.energy_neutral);
+        d.drag = Drag { rate: self.drag_rate, wind: self.drag_wind, field: one(self.drag_wind_field), vortex: one(self.drag_vortex) };
+        d.lifetimes = one(self.lifetimes);
+        if ones > 1 || self.forces & !FORCE_BITS != 0 || self.reserved != 0 {
+            return Err(mpca_status::BadEnum);
+        }
         d.dim = self.dim;
         d.seed = self.seed;
         d.size = self.size;
@@ -241,9 +260,7 @@ impl mpca_desc {
             }
         }
         d.mass = self.mass;
-        d.per_particle_mass = flag(self.per_particle_mass)?;
         d.mass_classes = self.mass_classes;
-        d.obstacles = flag(self.obstacles)?;
         d.surface_capacity = self.surface_capacity;
         d.forces = Forces {
             uniform: self.forces & mpca_force::Uniform as u32 != 0,
@@ -261,27 +278,13 @@ impl mpca_desc {
             16 => Quantization::Bits16,
             _ => return Err(mpca_status::BadEnum),
         };
-        d.drift = match self.drift {
-            0 => Drift::Paper,
-            1 => Drift::Calibrated,
-            _ => return Err(mpca_status::BadEnum),
-        };
         d.method = match self.method {
             0 => Method::Exhaustive,
             1 => Method::ExactFast,
             2 => Method::Greedy,
             _ => return Err(mpca_status::BadEnum),
         };
-        d.collisions = match self.collisions {
-            0 => Collisions::Paper,
-            1 => Collisions::SpeedLimited,
-            _ => return Err(mpca_status::BadEnum),
-        };
-        d.contacts = flag(self.contacts)?;
-        d.energy_neutral = flag(self.energy_neutral)?;
-        d.drag = Drag { rate: self.drag_rate, wind: self.drag_wind, field: flag(self.drag_wind_field)?, vortex: flag(self.drag_vortex)? };
         d.emitter_capacity = self.emitter_capacity;
-        d.lifetimes = flag(self.lifetimes)?;
         Ok(d)
     }
 }

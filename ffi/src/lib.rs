@@ -106,16 +106,6 @@ const _: () = {
     assert!(size_of::<mpca_status>() == 4 && size_of::<mpca_boundary>() == 4);
 };
 
-/// 0 or 1 as a bool; anything else is `BadEnum`.
-#[inline]
-pub(crate) fn flag(v: u32) -> Result<bool, mpca_status> {
-    match v {
-        0 => Ok(false),
-        1 => Ok(true),
-        _ => Err(mpca_status::BadEnum),
-    }
-}
-
 /// Checks the leading `struct_size` of a versioned structure.
 #[inline]
 pub(crate) fn check_size<T>(struct_size: u32) -> Result<(), mpca_status> {
