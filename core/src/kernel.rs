@@ -407,9 +407,13 @@ fn reflect_off<const D: usize>(sh: &Shared<'_>, x: [f32; 3], c: usize, to: Wante
         // Unreachable for obstacles added through the API (every cell
         // next to a free one has an entry): the direction back to the
         // particle.
-        None => (back_normal::<D>(c, t), sh.desc.wall_restitution),
+        None if cfg!(feature = "obstacles") => (back_normal::<D>(c, t), sh.desc.wall_restitution),
+        // Unreachable without obstacles: only cells beyond a wall are
+        // blocked then, and `resolve` gave their surface above. A normal
+        // of 0 would reflect nothing; the build holds no code for the
+        // direction back.
+        None => ([0.0; 3], sh.desc.wall_restitution),
     });
-    let back = back_normal::<D>(c, t);
     // Without obstacles only cells beyond a wall face are blocked, and a
     // particle asks for one only moving towards it (M5.3: every axis it
     // crosses points out of the domain), so N.v < 0: a build without
@@ -431,6 +435,7 @@ fn reflect_off<const D: usize>(sh: &Shared<'_>, x: [f32; 3], c: usize, to: Wante
         for (k, a) in at.iter_mut().enumerate().take(D) {
             *a += ((c >> k) & 1) as isize - ((t >> k) & 1) as isize;
         }
+        let back = back_normal::<D>(c, t);
         if dot(n, back) > 0.0 && crate::obstacle::axis_move_free(if cfg!(feature = "obstacles") { sh.obstacle } else { &[] }, sh.n, &sh.desc.boundary, at, x, D) {
             return None;
         }
