@@ -1082,7 +1082,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
             };
             // A force that changes nothing is no step 1: a zero-valued part
             // gives the same world as a world without it (M9).
-            if dv != [0.0; 3] {
+            if crate::vector::nonzero(dv) {
                 self.push(&mut b, c, dv, mass_of(c));
             }
         }

@@ -215,7 +215,7 @@ impl World {
             // A build without obstacles has no surface entry to slice.
             surface: if cfg!(feature = "obstacles") { &surface[..head.surfaces as usize] } else { &[] },
             mass_table,
-            push: (push != [0.0; 3]).then_some(push),
+            push: crate::vector::nonzero(push).then_some(push),
             terms,
             dt_q,
             drag: desc.has_drag().then(|| Flow {

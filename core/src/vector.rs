@@ -19,6 +19,20 @@ pub(crate) fn dot_of<const D: usize>(a: [f32; 3], b: [f32; 3]) -> f32 {
     sum
 }
 
+/// `v != [0.0; 3]`: whether a component is not zero (of either sign) or
+/// is NaN. On cores without an FPU from the bits (no comparisons of
+/// floats, each a library call there), elsewhere the comparison.
+#[inline(always)]
+pub(crate) fn nonzero(v: [f32; 3]) -> bool {
+    if NO_FPU { bitwise_nonzero(v) } else { v != [0.0; 3] }
+}
+
+/// [`nonzero`] from the bits: a set bit other than the signs.
+#[inline(always)]
+fn bitwise_nonzero(v: [f32; 3]) -> bool {
+    (v[0].to_bits() | v[1].to_bits() | v[2].to_bits()) << 1 != 0
+}
+
 /// The larger of `a` and `b`, neither of them NaN: `f32::max` without the
 /// library's `fmaxf` (a call on cores without the instruction), whose NaN
 /// rules such inputs never need.
@@ -144,6 +158,11 @@ fn bitwise_sqrt(x: f32) -> f32 {
     let root = root + u32::from(rest > root);
     f32::from_bits((((k / 2 + 127) as u32) << 23) + (root - 0x80_0000))
 }
+
+/// Whether the core has no floating-point unit (Arm without hard float):
+/// there every comparison of floats is a library call and [`div`] is
+/// [`bitwise_div`], a routine some 300 instructions long.
+pub(crate) const NO_FPU: bool = cfg!(all(target_arch = "arm", not(target_abi = "eabihf")));
 
 /// `a / b`, correctly rounded as IEEE 754 asks. On Arm cores without a
 /// floating-point unit [`bitwise_div`], some 530 bytes smaller than the
@@ -546,6 +565,17 @@ mod tests {
         // (zeros, subnormals, infinities, quiet and signalling NaNs) and
         // random bit patterns.
         edges_and_random(0x3c6e_f372, |x| assert_eq!(bitwise_is_nan(x), x.is_nan(), "{:#x}", x.to_bits()));
+    }
+
+    #[test]
+    fn bitwise_nonzero_is_not_all_zeros() {
+        // Expect: `v != [0.0; 3]` for every float at each place beside
+        // zeros of either sign, and beside another float.
+        edges_and_random(0x6a09_e667, |x| {
+            for v in [[x, 0.0, -0.0], [-0.0, x, 0.0], [0.0, 0.0, x], [x, 1.0, x]] {
+                assert_eq!(bitwise_nonzero(v), v != [0.0; 3], "{v:?}");
+            }
+        });
     }
 
     /// Calls `check` with the first and last four values of every
