@@ -46,12 +46,8 @@ impl ForceTerms<'_> {
             f[1] += t[1];
         }
         let mut a = self.gravity;
-        // F / 1 is F: where the division is a routine (cores without an
-        // FPU), a mass of 1 (the usual one) skips it; the same value, the
-        // components being finite.
-        let unit = crate::vector::NO_FPU && m.to_bits() == 1.0f32.to_bits();
         for k in 0..self.dim {
-            a[k] += if unit { f[k] } else { crate::vector::div(f[k], m) };
+            a[k] += crate::vector::div(f[k], m);
         }
         a
     }
