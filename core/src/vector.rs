@@ -2,6 +2,12 @@
 //! component 0 in 2D): dot product, normalisation, and the speed clamp of
 //! M5.5.
 
+/// Whether the core has no floating-point unit (Arm without hard float):
+/// there every operation on floats but a move is a library call, and the
+/// functions below that say so take an integer form of their own (each
+/// tested bit for bit against the operation, on every target).
+pub(crate) const NO_FPU: bool = cfg!(all(target_arch = "arm", not(target_abi = "eabihf")));
+
 #[inline]
 pub(crate) fn dot(a: [f32; 3], b: [f32; 3]) -> f32 {
     dot_of::<3>(a, b)
@@ -90,12 +96,8 @@ pub(crate) fn sqrt(x: f32) -> f32 {
         };
         f32::from_bits(root)
     }
-    #[cfg(all(target_arch = "arm", not(target_abi = "eabihf")))]
-    {
-        bitwise_sqrt(x)
-    }
-    #[cfg(not(target_arch = "arm"))]
-    libm::sqrtf(x)
+    #[cfg(not(all(target_arch = "arm", target_abi = "eabihf")))]
+    if NO_FPU { bitwise_sqrt(x) } else { libm::sqrtf(x) }
 }
 
 /// The square root of a non-negative `x` digit by digit in integers,
@@ -103,8 +105,8 @@ pub(crate) fn sqrt(x: f32) -> f32 {
 /// libm's routine and its table take some 580 bytes. `x` is never
 /// negative or NaN here (squared lengths, uniform draws); for those it
 /// gives NaN, for -0 and +infinity `x`. The tests hold it to libm bit for
-/// bit.
-#[cfg_attr(not(all(target_arch = "arm", not(target_abi = "eabihf"))), allow(dead_code))]
+/// bit. Hard-float Arm cores take the instruction instead.
+#[cfg_attr(all(target_arch = "arm", target_abi = "eabihf"), allow(dead_code))]
 fn bitwise_sqrt(x: f32) -> f32 {
     let bits = x.to_bits();
     if bits & 0x7fff_ffff == 0 || bits == 0x7f80_0000 {
@@ -159,25 +161,13 @@ fn bitwise_sqrt(x: f32) -> f32 {
     f32::from_bits((((k / 2 + 127) as u32) << 23) + (root - 0x80_0000))
 }
 
-/// Whether the core has no floating-point unit (Arm without hard float):
-/// there every comparison of floats is a library call and [`div`] is
-/// [`bitwise_div`], a routine some 300 instructions long.
-pub(crate) const NO_FPU: bool = cfg!(all(target_arch = "arm", not(target_abi = "eabihf")));
-
 /// `a / b`, correctly rounded as IEEE 754 asks. On Arm cores without a
 /// floating-point unit [`bitwise_div`], some 530 bytes smaller than the
 /// Rust runtime's `__divsf3` it replaces; elsewhere the division itself
 /// (an instruction, or the runtime's routine where the core has none).
 #[inline(always)]
 pub(crate) fn div(a: f32, b: f32) -> f32 {
-    #[cfg(all(target_arch = "arm", not(target_abi = "eabihf")))]
-    {
-        bitwise_div(a, b)
-    }
-    #[cfg(not(all(target_arch = "arm", not(target_abi = "eabihf"))))]
-    {
-        a / b
-    }
+    if NO_FPU { bitwise_div(a, b) } else { a / b }
 }
 
 /// `a / b` by long division of the significands in 32-bit integers,
@@ -191,7 +181,6 @@ pub(crate) fn div(a: f32, b: f32) -> f32 {
 /// `x / 0` and `inf / x` signed infinities, `0 / x` and `x / inf` signed
 /// zeros; subnormal operands and results, and overflow to infinity, are
 /// rounded as any other. The tests hold it to the division bit for bit.
-#[cfg_attr(not(all(target_arch = "arm", not(target_abi = "eabihf"))), allow(dead_code))]
 fn bitwise_div(a: f32, b: f32) -> f32 {
     const INF: u32 = 0x7f80_0000;
     let (x, y) = (a.to_bits(), b.to_bits());
@@ -304,18 +293,10 @@ pub(crate) fn small_to_f32(x: u32) -> f32 {
 /// vectorises.
 #[inline(always)]
 pub(crate) fn is_nan(x: f32) -> bool {
-    #[cfg(all(target_arch = "arm", not(target_abi = "eabihf")))]
-    {
-        bitwise_is_nan(x)
-    }
-    #[cfg(not(all(target_arch = "arm", not(target_abi = "eabihf"))))]
-    {
-        x.is_nan()
-    }
+    if NO_FPU { bitwise_is_nan(x) } else { x.is_nan() }
 }
 
 /// `x.is_nan()` from its bits: the magnitude's above infinity's.
-#[cfg_attr(not(all(target_arch = "arm", not(target_abi = "eabihf"))), allow(dead_code))]
 #[inline(always)]
 fn bitwise_is_nan(x: f32) -> bool {
     x.to_bits() & 0x7fff_ffff > 0x7f80_0000
@@ -328,12 +309,9 @@ fn bitwise_is_nan(x: f32) -> bool {
 #[inline(always)]
 pub(crate) fn whole_part(y: f32) -> i32 {
     debug_assert!((1.0..16_777_216.0).contains(&y));
-    #[cfg(all(target_arch = "arm", not(target_abi = "eabihf")))]
-    {
+    if NO_FPU {
         bitwise_whole_part(y)
-    }
-    #[cfg(not(all(target_arch = "arm", not(target_abi = "eabihf"))))]
-    {
+    } else {
         // SAFETY: y is finite and below 2^31 (the caller's bound).
         unsafe { y.to_int_unchecked::<i32>() }
     }
@@ -342,7 +320,6 @@ pub(crate) fn whole_part(y: f32) -> i32 {
 /// The integer part of a `y` in `[1, 2^24)` from its bits: the significand
 /// with its top bit (a value in `[2^23, 2^24)`), shifted right by 23 less
 /// the exponent (150 less the exponent field; 0 to 23 places).
-#[cfg_attr(not(all(target_arch = "arm", not(target_abi = "eabihf"))), allow(dead_code))]
 #[inline(always)]
 fn bitwise_whole_part(y: f32) -> i32 {
     let bits = y.to_bits();
