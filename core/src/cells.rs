@@ -19,7 +19,8 @@ use core::ptr::NonNull;
 /// Within one step, an element is accessed by at most one task: the
 /// partition gives every element to exactly one row of blocks, and every
 /// row of blocks to exactly one task (`Partition::band`). Every access is
-/// bounds-checked.
+/// bounds-checked, but for [`Cells::pair_unchecked`], whose caller proves
+/// the bound.
 pub(crate) struct Cells<'a, T> {
     ptr: NonNull<T>,
     len: usize,
@@ -71,6 +72,19 @@ impl<'a, T: Copy> Cells<'a, T> {
             out_of_bounds(i + 1, self.len);
         }
         // SAFETY: as in `get`, for both elements.
+        unsafe { [self.ptr.as_ptr().add(i).read(), self.ptr.as_ptr().add(i + 1).read()] }
+    }
+
+    /// Elements `i` and `i + 1`, without the bounds check: for the lanes
+    /// routine, whose row plan proves the bound once for a row of blocks.
+    ///
+    /// # Safety
+    /// `i + 1 < self.len()`.
+    #[inline(always)]
+    pub unsafe fn pair_unchecked(&self, i: usize) -> [T; 2] {
+        debug_assert!(i < self.len && self.len - i >= 2);
+        // SAFETY: both elements are in bounds (the caller's promise); the
+        // rest as in `get`.
         unsafe { [self.ptr.as_ptr().add(i).read(), self.ptr.as_ptr().add(i + 1).read()] }
     }
 

@@ -117,6 +117,18 @@ pub(crate) struct Kernel<'a, Q, const D: usize, const CELLS: usize> {
     pub counters: Counters,
 }
 
+/// A row of blocks as [`Kernel::visit`] sees it, worked out once a row.
+#[derive(Clone, Copy)]
+pub(crate) struct RowPlan {
+    /// The blocks with x0 below it go to [`Kernel::lean_2d`] (where the
+    /// world lets them: 0 where it does not), the others to
+    /// [`Kernel::general`]: a row of blocks away from the y faces, up to
+    /// the block that wraps round x.
+    lean_below: usize,
+    /// The world has obstacles: a block's own are read before it is lean.
+    obstacles: bool,
+}
+
 /// `sqrt(D)` quanta for D = 2, 3: the most stochastic rounding can add to a
 /// speed.
 const ROUNDING_MARGIN: [f32; 2] = [core::f32::consts::SQRT_2, 1.732_050_8];
@@ -916,11 +928,15 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
     fn lean_2d(&mut self, row: &BlockRow, x0: usize, index: u64, occ: u8) {
         let sh = self.shared;
         let velocity = self.planes.velocity;
+        // Both block rows, occupied or not: the lanes of an empty cell are
+        // never read as a velocity (every use is masked by `occ`), and a
+        // row written back whole writes them back as they were.
         let mut lanes = 0u64;
         for r in 0..2 {
-            if occ >> (2 * r) & 3 != 0 {
-                lanes |= u64::from(Q::lanes_2d(velocity.pair(x0 + row.cell[r]))) << (32 * r);
-            }
+            // SAFETY: x0 < RowPlan::lean_below, so x0 + 1 + row.cell[r] is
+            // below the plane's length (`plan`).
+            let pair = unsafe { velocity.pair_unchecked(x0 + row.cell[r]) };
+            lanes |= u64::from(Q::lanes_2d(pair)) << (32 * r);
         }
         let mut rng = sh.key.stream(index);
         let pair = pick_pair::<D>(occ, &mut rng);
@@ -1179,36 +1195,49 @@ impl<'a, Q: Quant, const D: usize, const CELLS: usize> BlockSink<'a> for Kernel<
         Index { occupancy: self.planes.occupancy, rows: self.planes.rows, words: self.planes.words }
     }
 
+    type Plan = RowPlan;
+
+    /// What is the same for every block of `row` in the choice of routine,
+    /// so that the choice is one compare a block.
     #[inline(always)]
-    fn visit(&mut self, row: &BlockRow, x0: isize, bx: usize, occ: u8) {
+    fn plan(&self, row: &BlockRow) -> RowPlan {
+        // With `small-step` no block is lean (`visit`).
+        if cfg!(feature = "small-step") {
+            return RowPlan { lean_below: 0, obstacles: false };
+        }
         let sh = self.shared;
+        // 2D, 8 bits: the lanes routine or the general one (worlds with
+        // contacts among them), never `lean`, which is then left out. Every
+        // x0 < n - 1 reads cells x0 and x0 + 1 of both domain rows, which
+        // lie in the velocity plane (checked here, once a row: the lanes
+        // routine reads them unchecked).
+        let lean = if D == 2 && Q::LANES {
+            sh.lanes && row.cell[0].max(row.cell[1]) <= self.planes.velocity.len().saturating_sub(sh.n[0])
+        } else {
+            sh.plain
+        };
+        let lean = lean && row.outside == 0;
+        RowPlan { lean_below: if lean { sh.n[0] - 1 } else { 0 }, obstacles: sh.desc.has_obstacles() }
+    }
+
+    #[inline(always)]
+    fn visit(&mut self, row: &BlockRow, plan: RowPlan, x0: isize, bx: usize, occ: u8) {
+        // With `small-step` the general routine alone (the lean ones left
+        // out of the build).
         if cfg!(feature = "small-step") {
             return self.general(row, x0, bx, occ);
         }
-        if D == 2 && Q::LANES {
-            // 2D, 8 bits: the lanes routine or the general one (the few
-            // blocks across the wrap, the half blocks, worlds with
-            // contacts), never `lean`, which this routine then leaves out.
-            // The half block's x0 = -1 is usize::MAX here, which fails the
-            // test on x (n >= 1: Layout::of refuses an empty axis).
-            let x = x0 as usize;
-            let pairwise = sh.lanes && row.outside == 0 && x < sh.n[0] - 1;
-            if pairwise && (!sh.desc.has_obstacles() || read_block::<CELLS>(sh.obstacle, row, [x, x + 1]) == 0) {
-                return self.lean_2d(row, x, row.index + bx as u64, occ);
+        // The half block's x0 = -1 is usize::MAX here, and the block that
+        // wraps round a periodic x axis has x0 = n - 1: both fail the test
+        // (the lean routines read a block row's two cells as neighbours).
+        let x = x0 as usize;
+        // A world with obstacles: only blocks without one are lean.
+        if x < plan.lean_below && (!plan.obstacles || read_block::<CELLS>(self.shared.obstacle, row, [x, x + 1]) == 0) {
+            let index = row.index + bx as u64;
+            if D == 2 && Q::LANES {
+                return self.lean_2d(row, x, index, occ);
             }
-            return self.general(row, x0, bx, occ);
-        }
-        if sh.plain && row.outside == 0 && x0 >= 0 {
-            let x0 = x0 as usize;
-            // The block that wraps round a periodic x axis goes through
-            // the general routine: the lean one reads each block row's two
-            // cells as neighbours.
-            if x0 + 1 < sh.n[0] {
-                // A world with obstacles: only blocks without one are lean.
-                if !sh.desc.has_obstacles() || read_block::<CELLS>(sh.obstacle, row, [x0, x0 + 1]) == 0 {
-                    return self.lean(row, [x0, x0 + 1], row.index + bx as u64, occ);
-                }
-            }
+            return self.lean(row, [x, x + 1], index, occ);
         }
         self.general(row, x0, bx, occ);
     }

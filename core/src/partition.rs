@@ -147,10 +147,15 @@ pub(crate) trait BlockSink<'a> {
     /// The planes the sweep reads and the summaries it keeps, read between
     /// visits.
     fn index(&self) -> Index<'a>;
+    /// What the sink decides once for a row of blocks, handed back to each
+    /// visit of that row.
+    type Plan: Copy;
+    /// The plan of `row`, made before its first block is visited.
+    fn plan(&self, row: &BlockRow) -> Self::Plan;
     /// Processes block `bx` of `row`, whose lowest corner has x `x0` and
     /// whose cells holding a particle are the set bits of `occ` (bit `c` for
     /// cell `c`, never a cell beyond a face).
-    fn visit(&mut self, row: &BlockRow, x0: isize, bx: usize, occ: u8);
+    fn visit(&mut self, row: &BlockRow, plan: Self::Plan, x0: isize, bx: usize, occ: u8);
 }
 
 /// The block cells with offset `d` along axis `k`, for blocks of `2^dim`
@@ -353,7 +358,9 @@ impl Partition {
                     }
                 }
                 if occ != 0 {
-                    sink.visit(&row, x0, bx, occ);
+                    // The plan at each block: with `small-step` it is a
+                    // constant, and nothing is kept for the row.
+                    sink.visit(&row, sink.plan(&row), x0, bx, occ);
                 }
             };
             // The blocks of the set bits, each once: `next` is the first
@@ -477,11 +484,12 @@ impl Partition {
         // its cell 1 in bit 0 of each row, and the pairs after it start at
         // index 1.
         let half = self.offset == 1 && !ax.periodic;
+        let plan = sink.plan(row);
         let half_block = |sink: &mut S| {
             let first = Self::words::<ROWS>(idx.occupancy, row, 0).map(|m| (m & 1) << 1);
             let bits = block(&first, 0);
             if bits != 0 {
-                sink.visit(row, -1, 0, bits);
+                sink.visit(row, plan, -1, 0, bits);
             }
         };
         // The rows' flags start cleared; they are set again below for every
@@ -556,7 +564,7 @@ impl Partition {
                     // offset 1). One call for both offsets: the block
                     // routines are inlined here, and a call in each branch
                     // copied them twice (49 KB of libmpca.so).
-                    sink.visit(row, (2 * pair + self.offset) as isize, pair + usize::from(half), occ);
+                    sink.visit(row, plan, (2 * pair + self.offset) as isize, pair + usize::from(half), occ);
                 }
             }
         }
