@@ -19,8 +19,8 @@ use core::ptr::NonNull;
 /// Within one step, an element is accessed by at most one task: the
 /// partition gives every element to exactly one row of blocks, and every
 /// row of blocks to exactly one task (`Partition::band`). Every access is
-/// bounds-checked, but for [`Cells::pair_unchecked`], whose caller proves
-/// the bound.
+/// bounds-checked, but for [`Cells::pair_unchecked`] and
+/// [`Cells::set_pair_unchecked`], whose caller proves the bound.
 pub(crate) struct Cells<'a, T> {
     ptr: NonNull<T>,
     len: usize,
@@ -88,13 +88,16 @@ impl<'a, T: Copy> Cells<'a, T> {
         unsafe { [self.ptr.as_ptr().add(i).read(), self.ptr.as_ptr().add(i + 1).read()] }
     }
 
-    /// Sets elements `i` and `i + 1`, with one bounds check.
+    /// Sets elements `i` and `i + 1` without the bounds check: the lanes
+    /// routine's write-back, bounded as [`Cells::pair_unchecked`] is.
+    ///
+    /// # Safety
+    /// `i + 1 < self.len()`.
     #[inline(always)]
-    pub fn set_pair(&self, i: usize, v: [T; 2]) {
-        if self.len < 2 || i > self.len - 2 {
-            out_of_bounds(i + 1, self.len);
-        }
-        // SAFETY: as in `get`, for both elements.
+    pub unsafe fn set_pair_unchecked(&self, i: usize, v: [T; 2]) {
+        debug_assert!(i < self.len && self.len - i >= 2);
+        // SAFETY: both elements are in bounds (the caller's promise); the
+        // rest as in `get`.
         unsafe {
             self.ptr.as_ptr().add(i).write(v[0]);
             self.ptr.as_ptr().add(i + 1).write(v[1]);

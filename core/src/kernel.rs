@@ -965,15 +965,30 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
         }
 
         self.counters.processed += 1;
-        if want != 0 || pending != 0 {
+        if want != 0 {
             self.finish_2d(row, x0, occ, lanes, want, pending, &mut rng);
+        } else if pending != 0 {
+            self.write_rows(row, x0, lanes, pending);
+        }
+    }
+
+    /// The block rows of a lanes block holding a velocity that changed
+    /// (`pending`), written back whole from `lanes` (the row's other cell
+    /// as it was read), where no particle moved.
+    #[inline(always)]
+    fn write_rows(&mut self, row: &BlockRow, x0: usize, lanes: u64, pending: u8) {
+        for r in 0..2 {
+            if pending >> (2 * r) & 3 != 0 {
+                // SAFETY: as for the read in `lean_2d`: x0 < lean_below.
+                unsafe { self.planes.velocity.set_pair_unchecked(x0 + row.cell[r], Q::pair_from_lanes((lanes >> (32 * r)) as u32)) };
+            }
         }
     }
 
     /// The rest of [`Kernel::lean_2d`] for a block where a particle wants
-    /// to move or a velocity changed (`pending`): M5.6, then the moved and
-    /// changed velocities and the occupancy written back. Out of line: in
-    /// a cooling gas most blocks need neither, and the sweep's loop keeps
+    /// to move: M5.6, then the moved velocities and those that changed
+    /// (`pending`) and the occupancy written back. Out of line: in a
+    /// cooling gas most blocks need none of it, and the sweep's loop keeps
     /// its registers.
     #[inline(never)]
     #[allow(clippy::too_many_arguments)]
@@ -981,24 +996,13 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
         let sh = self.shared;
         let velocity = self.planes.velocity;
         // M5.6.
-        let targets = if want == 0 {
-            IDENTITY
-        } else {
-            let wants = [want & 3, want >> 2 & 3, want >> 4 & 3, want >> 6];
-            let mut per_cell = [0u8; CELLS];
-            per_cell[..4].copy_from_slice(&wants);
-            let key = 2 * usize::from(BLOCKED_KEY_2D[usize::from(occ)]) + usize::from(KEY_2D_WANTS[usize::from(want)]);
-            self.assign(occ, |c| { let x = lane_quanta(lanes, c); dot(x, x) }, 0, &per_cell, key, rng)
-        };
+        let wants = [want & 3, want >> 2 & 3, want >> 4 & 3, want >> 6];
+        let mut per_cell = [0u8; CELLS];
+        per_cell[..4].copy_from_slice(&wants);
+        let key = 2 * usize::from(BLOCKED_KEY_2D[usize::from(occ)]) + usize::from(KEY_2D_WANTS[usize::from(want)]);
+        let targets = self.assign(occ, |c| { let x = lane_quanta(lanes, c); dot(x, x) }, 0, &per_cell, key, rng);
         if (targets ^ IDENTITY) & FIELDS[usize::from(occ)] == 0 {
-            // Nothing moved: the block rows holding a changed velocity are
-            // written back whole from the lanes (the other cell as it was).
-            for r in 0..2 {
-                if pending >> (2 * r) & 3 != 0 {
-                    velocity.set_pair(x0 + row.cell[r], Q::pair_from_lanes((lanes >> (32 * r)) as u32));
-                }
-            }
-            return;
+            return self.write_rows(row, x0, lanes, pending);
         }
         let mut after = 0u8;
         each_cell!(CELLS, c => {
