@@ -206,7 +206,7 @@ impl World {
             let slot: Slot = self.slots()[i];
             let e = slot.emitter;
             let mut rng = key.stream(i as u64);
-            let whole = whole_part(e.rate);
+            let whole = floor_rate(e.rate);
             // Casting saturates, so an absurd rate asks for u64::MAX.
             let wanted = crate::vector::saturating_u64(whole).saturating_add(u64::from(rng.chance(e.rate - whole)));
             if wanted == 0 {
@@ -247,7 +247,7 @@ impl World {
 /// `floor(x)` for an `x` that is not negative (a rate: `checked`), by
 /// clearing the bits of its fraction: a few instructions where `floorf`
 /// is a library routine of some 100 bytes.
-fn whole_part(x: f32) -> f32 {
+fn floor_rate(x: f32) -> f32 {
     let bits = x.to_bits();
     let exponent = (bits >> 23 & 0xff) as i32 - 127;
     if exponent < 0 {
@@ -315,11 +315,11 @@ mod tests {
     }
 
     #[test]
-    fn whole_part_is_floor_for_rates() {
+    fn floor_rate_is_floor_for_rates() {
         // Expect: floorf's value, bit for bit, for 0, -0, every power of
         // two's neighbours, infinity and random values of every size.
         let mut rng = block_stream(9, 9, 9);
-        let check = |x: f32| assert_eq!(whole_part(x).to_bits(), libm::floorf(x).to_bits(), "{x:e}");
+        let check = |x: f32| assert_eq!(floor_rate(x).to_bits(), libm::floorf(x).to_bits(), "{x:e}");
         check(0.0);
         check(-0.0);
         check(f32::INFINITY);
