@@ -69,8 +69,9 @@ impl World {
     /// handles every part (none through the lean one that plain worlds use
     /// away from the faces), and with every row and word of the occupancy
     /// swept (none skipped on the summaries' word). The world is the same
-    /// bit for bit: the tests compare the two (feature `reference`).
-    #[cfg(feature = "reference")]
+    /// bit for bit: the tests compare the two (feature `reference`, and
+    /// the crate's own tests).
+    #[cfg(any(test, feature = "reference"))]
     pub fn step_reference(&mut self) {
         self.step_routed(Route { reverse: false, lean: false, skip: false });
     }
