@@ -120,10 +120,11 @@ pub(crate) struct Kernel<'a, Q, const D: usize, const CELLS: usize> {
 /// A row of blocks as [`Kernel::visit`] sees it, worked out once a row.
 #[derive(Clone, Copy)]
 pub(crate) struct RowPlan {
-    /// The blocks with x0 below it go to [`Kernel::lean_2d`] (where the
-    /// world lets them: 0 where it does not), the others to
-    /// [`Kernel::general`]: a row of blocks away from the y faces, up to
-    /// the block that wraps round x.
+    /// The blocks with x0 below it go to a lean routine
+    /// ([`Kernel::lean_2d`] for 2D 8-bit worlds, [`Kernel::lean`] for the
+    /// others), where the world lets them (0 where it does not), and the
+    /// others to [`Kernel::general`]: in a row of blocks away from the y
+    /// and z faces, every block up to the one that wraps round x.
     lean_below: usize,
     /// The world has obstacles: a block's own are read before it is lean.
     obstacles: bool,

@@ -150,7 +150,8 @@ pub(crate) trait BlockSink<'a> {
     /// What the sink decides once for a row of blocks, handed back to each
     /// visit of that row.
     type Plan: Copy;
-    /// The plan of `row`, made before its first block is visited.
+    /// The plan of `row`: made once before its blocks are visited (the
+    /// small sweep makes it at each block, where it is a constant).
     fn plan(&self, row: &BlockRow) -> Self::Plan;
     /// Processes block `bx` of `row`, whose lowest corner has x `x0` and
     /// whose cells holding a particle are the set bits of `occ` (bit `c` for
