@@ -951,14 +951,18 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
         let mut want = 0u8;
         let inward = inward_lanes(lanes, occ);
         if inward != 0 {
-            let bytes = rng.next_u64();
+            // Lane i's random byte and stored component as byte i of an
+            // array: one indexed load each, where a shift of the word by
+            // 8i took three instructions.
+            let bytes = rng.next_u64().to_le_bytes();
+            let stored = lanes.to_le_bytes();
             let table = sh.moves;
             let mut todo = inward;
             while todo != 0 {
-                let i = todo.trailing_zeros();
+                let i = todo.trailing_zeros() as usize;
                 todo &= todo - 1;
-                let limit = u32::from(table[usize::from((lanes >> (8 * i)) as u8)]);
-                let (high, top) = ((bytes >> (8 * i)) as u8 as u32, limit >> 8);
+                let limit = u32::from(table[usize::from(stored[i])]);
+                let (high, top) = (u32::from(bytes[i]), limit >> 8);
                 if high < top || high == top && rng.bits(8) <= limit & 0xff {
                     want |= 1 << i;
                 }
