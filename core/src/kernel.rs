@@ -872,7 +872,11 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
             // (a < c in every pair), as the loop below would.
             let Some((a, c)) = pair else { return (lanes, 0) };
             debug_assert!(a < c);
-            let Some((xa, xc)) = self.collide_two(lane_quanta(lanes, a), lane_quanta(lanes, c), (mass, mass), true, rng) else {
+            // The lanes as bytes: a cell's components are one indexed load
+            // each, and its rounded ones one indexed store.
+            let mut bytes = lanes.to_le_bytes();
+            let quanta = |c: usize| [f32::from(bytes[2 * c] as i8), f32::from(bytes[2 * c + 1] as i8), 0.0];
+            let Some((xa, xc)) = self.collide_two(quanta(a), quanta(c), (mass, mass), true, rng) else {
                 return (lanes, 0);
             };
             // The four components together: 32 bits for a, then 32 for c.
@@ -881,13 +885,11 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
             let q: [i32; 4] = core::array::from_fn(|i| Q::stochastic(x[i], r[i / 2] >> (16 * (i & 1))));
             // 8-bit rounding stays within the stored range (+-127): the
             // lane is the value's low byte.
-            let lane = |q: i32| {
+            for (i, q) in q.into_iter().enumerate() {
                 debug_assert_eq!(q, Q::from_int(q).to_int());
-                u64::from(q as u8)
-            };
-            let (at_a, at_c) = (16 * a, 16 * c);
-            lanes &= !(0xffff << at_a | 0xffff << at_c);
-            lanes |= (lane(q[0]) | lane(q[1]) << 8) << at_a | (lane(q[2]) | lane(q[3]) << 8) << at_c;
+                bytes[2 * [a, c][i / 2] + (i & 1)] = q as u8;
+            }
+            lanes = u64::from_le_bytes(bytes);
             return (lanes, 1 << a | 1 << c);
         }
         let mut x = [[0.0f32; 3]; CELLS];
