@@ -80,6 +80,11 @@ pub(crate) struct Shared<'a> {
     pub drag: Option<Flow<'a>>,
     /// The 8-bit move table of the drift rule (M5.3).
     pub moves: &'static [u16; 256],
+    /// The high bytes of `moves`' entries, which the lanes routine reads
+    /// ([`Shared::tops`]; not built with `small-step`, which never calls
+    /// that routine).
+    #[cfg(not(feature = "small-step"))]
+    pub tops: &'static [u8; 256],
     /// Forces other than a uniform one (fields, potentials, the vortex,
     /// drag) are summed per particle, in [`Kernel::general`].
     pub summed: bool,
@@ -90,6 +95,19 @@ pub(crate) struct Shared<'a> {
     /// `plain` without contacts (M5.7): what [`Kernel::lean_2d`] needs of
     /// the step, tested once a block.
     pub lanes: bool,
+}
+
+impl Shared<'_> {
+    /// The high bytes of the move table's entries, for the lanes routine.
+    #[inline(always)]
+    fn tops(&self) -> &'static [u8; 256] {
+        #[cfg(not(feature = "small-step"))]
+        return self.tops;
+        // `visit` sends every block to the general routine with
+        // `small-step`: the lanes routine, and this, never run.
+        #[cfg(feature = "small-step")]
+        unreachable!("small-step has no lanes routine")
+    }
 }
 
 /// The planes a step writes; `velocity` holds a cell's `D` components
@@ -958,14 +976,14 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
             // 8i took three instructions.
             let bytes = rng.next_u64().to_le_bytes();
             let stored = lanes.to_le_bytes();
-            let table = sh.moves;
+            let (table, tops) = (sh.moves, sh.tops());
             let mut todo = inward;
             while todo != 0 {
                 let i = todo.trailing_zeros() as usize;
                 todo &= todo - 1;
-                let limit = u32::from(table[usize::from(stored[i])]);
-                let (high, top) = (u32::from(bytes[i]), limit >> 8);
-                if high < top || high == top && rng.bits(8) <= limit & 0xff {
+                let v = usize::from(stored[i]);
+                let (high, top) = (bytes[i], tops[v]);
+                if high < top || high == top && rng.bits(8) <= u32::from(table[v]) & 0xff {
                     want |= 1 << i;
                 }
             }

@@ -142,11 +142,38 @@ const fn move_table(calibrated: bool) -> [u16; 256] {
 static PAPER_8: [u16; 256] = move_table(false);
 static CALIBRATED_8: [u16; 256] = move_table(true);
 
+/// The high bytes of a move table's entries: what the lanes routine
+/// compares a random byte with first, without the shift.
+#[cfg(not(feature = "small-step"))]
+const fn tops(table: &[u16; 256]) -> [u8; 256] {
+    let mut t = [0; 256];
+    let mut b = 0;
+    while b < 256 {
+        t[b] = (table[b] >> 8) as u8;
+        b += 1;
+    }
+    t
+}
+
+#[cfg(not(feature = "small-step"))]
+static PAPER_TOPS_8: [u8; 256] = tops(&move_table(false));
+#[cfg(not(feature = "small-step"))]
+static CALIBRATED_TOPS_8: [u8; 256] = tops(&move_table(true));
+
 /// The 8-bit move table of a drift rule.
 pub(crate) fn move_table_8(drift: Drift) -> &'static [u16; 256] {
     match drift {
         Drift::Paper => &PAPER_8,
         Drift::Calibrated => &CALIBRATED_8,
+    }
+}
+
+/// The high bytes of [`move_table_8`]'s entries for a drift rule.
+#[cfg(not(feature = "small-step"))]
+pub(crate) fn move_tops_8(drift: Drift) -> &'static [u8; 256] {
+    match drift {
+        Drift::Paper => &PAPER_TOPS_8,
+        Drift::Calibrated => &CALIBRATED_TOPS_8,
     }
 }
 

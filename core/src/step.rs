@@ -228,6 +228,8 @@ impl World {
                 rate: desc.dt * desc.drag.rate,
             }),
             moves: crate::quant::move_table_8(desc.drift),
+            #[cfg(not(feature = "small-step"))]
+            tops: crate::quant::move_tops_8(desc.drift),
             summed,
             plain,
             lanes: plain && !desc.has_contacts(),
