@@ -977,7 +977,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
             let bytes = rng.next_u64().to_le_bytes();
             let stored = lanes.to_le_bytes();
             let (table, tops) = (sh.moves, sh.tops());
-            let mut todo = inward;
+            let mut todo = u32::from(inward);
             while todo != 0 {
                 let i = todo.trailing_zeros() as usize;
                 todo &= todo - 1;
