@@ -279,11 +279,27 @@ fn lane_quanta(lanes: u64, c: usize) -> [f32; 3] {
     [f32::from(x), f32::from(y), 0.0]
 }
 
-/// Cell `c`'s stored velocity in byte lanes, as integers.
+/// Cell `c`'s stored velocity in byte lanes, as integers: bytes `2c` and
+/// `2c + 1` of the word, one indexed load each where `c` is not a
+/// constant (a shift by `16 c` and masks take more instructions and
+/// registers).
 #[inline(always)]
 fn lane_ints(lanes: u64, c: usize) -> [i8; 2] {
-    let q = cell_lanes(lanes, c);
-    [q as u8 as i8, (q >> 8) as u8 as i8]
+    let bytes = lanes.to_le_bytes();
+    [bytes[2 * c] as i8, bytes[2 * c + 1] as i8]
+}
+
+/// `lanes` with cell `c`'s two lanes replaced by the stored components
+/// `q` (in range: each lane is the value's low byte), one indexed store
+/// each.
+#[inline(always)]
+fn with_lane_ints(lanes: u64, c: usize, q: [i32; 2]) -> u64 {
+    let mut bytes = lanes.to_le_bytes();
+    for (k, q) in q.into_iter().enumerate() {
+        debug_assert!((-127..=127).contains(&q));
+        bytes[2 * c + k] = q as u8;
+    }
+    u64::from_le_bytes(bytes)
 }
 
 /// Cell `c`'s two byte lanes, in the low 16 bits.
@@ -882,32 +898,22 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
         let mass = self.shared.desc.mass;
         // Cell c's lanes replaced by the rounding of x (M1).
         let round_into = |lanes: u64, c: usize, x: [f32; 3], rng: &mut Stream| {
-            let [qx, qy] = Q::round::<2>(x, rng).map(|q| u64::from(Q::from_int(q).to_int() as u8));
-            lanes & !(0xffff << (16 * c)) | (qx | qy << 8) << (16 * c)
+            with_lane_ints(lanes, c, Q::round::<2>(x, rng).map(|q| Q::from_int(q).to_int()))
         };
         if self.shared.push.is_none() {
             // The collision alone: its two results rounded in cell order
             // (a < c in every pair), as the loop below would.
             let Some((a, c)) = pair else { return (lanes, 0) };
             debug_assert!(a < c);
-            // The lanes as bytes: a cell's components are one indexed load
-            // each, and its rounded ones one indexed store.
-            let mut bytes = lanes.to_le_bytes();
-            let quanta = |c: usize| [f32::from(bytes[2 * c] as i8), f32::from(bytes[2 * c + 1] as i8), 0.0];
-            let Some((xa, xc)) = self.collide_two(quanta(a), quanta(c), (mass, mass), true, rng) else {
+            let Some((xa, xc)) = self.collide_two(lane_quanta(lanes, a), lane_quanta(lanes, c), (mass, mass), true, rng) else {
                 return (lanes, 0);
             };
             // The four components together: 32 bits for a, then 32 for c.
             let r = [rng.bits(32), rng.bits(32)];
             let x = [xa[0], xa[1], xc[0], xc[1]];
             let q: [i32; 4] = core::array::from_fn(|i| Q::stochastic(x[i], r[i / 2] >> (16 * (i & 1))));
-            // 8-bit rounding stays within the stored range (+-127): the
-            // lane is the value's low byte.
-            for (i, q) in q.into_iter().enumerate() {
-                debug_assert_eq!(q, Q::from_int(q).to_int());
-                bytes[2 * [a, c][i / 2] + (i & 1)] = q as u8;
-            }
-            lanes = u64::from_le_bytes(bytes);
+            // 8-bit rounding stays within the stored range (+-127).
+            lanes = with_lane_ints(with_lane_ints(lanes, a, [q[0], q[1]]), c, [q[2], q[3]]);
             return (lanes, 1 << a | 1 << c);
         }
         let mut x = [[0.0f32; 3]; CELLS];
