@@ -115,12 +115,10 @@ fn bitwise_sqrt(x: f32) -> f32 {
     if bits > 0x7f80_0000 {
         return f32::NAN; // negative or NaN
     }
-    // x = m 2^(k - 23) with m of 24 significant bits: m the 23 bits and
-    // the implicit top one at bit 23 (the bits less the exponent field
-    // plus 1); a subnormal (field 0, scaled as field 1) its bits, its top
-    // bit then brought to bit 23.
-    let f = (bits >> 23).max(1);
-    let (mut m, mut k) = (bits - ((f - 1) << 23), f as i32 - 127);
+    // x = m 2^(k - 23) with m of 24 significant bits ([`unpack`]); a
+    // subnormal's top bit then brought to bit 23.
+    let (mut m, f) = unpack(bits);
+    let mut k = f - 127;
     while m < 0x80_0000 {
         m <<= 1;
         k -= 1;
@@ -170,6 +168,17 @@ pub(crate) fn div(a: f32, b: f32) -> f32 {
     if NO_FPU { bitwise_div(a, b) } else { a / b }
 }
 
+/// A finite, non-negative `f32`'s bits as `(m, f)` with the value
+/// `m 2^(f - 150)`: `f` its exponent field, `m` its 23 bits with the
+/// implicit top one at bit 23 (the bits less the field, plus 1); a
+/// subnormal (field 0) is its bits, scaled as field 1. For the integer
+/// forms of the square root and the division.
+#[inline(always)]
+fn unpack(bits: u32) -> (u32, i32) {
+    let f = (bits >> 23).max(1);
+    (bits - ((f - 1) << 23), f as i32)
+}
+
 /// `a / b` by long division of the significands in 32-bit integers,
 /// correctly rounded (to nearest, ties to even): for Arm cores without a
 /// floating-point unit, where the runtime's `__divsf3` takes some 530
@@ -202,13 +211,7 @@ fn bitwise_div(a: f32, b: f32) -> f32 {
         // without the 26 steps of the long division.
         return a;
     }
-    // Each operand as m 2^(f - 150), f its exponent field: m its 23 bits
-    // and the implicit top one at bit 23 (the bits less the field plus 1);
-    // a subnormal (field 0) is its bits, scaled as field 1.
-    let unpack = |bits: u32| {
-        let f = (bits >> 23).max(1);
-        (bits - ((f - 1) << 23), f as i32)
-    };
+    // Each operand as m 2^(f - 150) ([`unpack`]).
     let (mut ma, fa) = unpack(ax);
     let (mut mb, fb) = unpack(ay);
     // The quotient of the significands brought to [1, 2), that is mb <= ma
