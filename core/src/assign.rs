@@ -40,7 +40,7 @@
 //! - [`Method::Greedy`], the paper's 3D approximation: the particles, fastest
 //!   first, each take their best untaken cell.
 
-use crate::rng::Stream;
+use crate::rules::rng::Stream;
 
 /// How particles are assigned to the cells of their block (M5.6).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -1439,7 +1439,7 @@ mod tests {
     use std::vec::Vec;
 
     use super::*;
-    use crate::rng::block_stream;
+    use crate::rules::rng::block_stream;
 
     /// Every target free and inside the block, no two particles on one cell.
     fn valid(problem: &MoveProblem, assignment: &Assignment, cells: usize) -> bool {
@@ -1513,7 +1513,7 @@ mod tests {
     /// other; returns the exhaustive cost.
     fn check_block<const D: usize>(
         problem: &MoveProblem,
-        rng: &mut crate::rng::Stream,
+        rng: &mut crate::rules::rng::Stream,
     ) -> (u32, u32) {
         let cells = 1 << D;
         let exhaustive = assign_moves::<D>(Method::Exhaustive, problem, rng);
@@ -1666,7 +1666,7 @@ mod tests {
 
     /// A random 3D block: `count` particles on distinct cells, random wishes
     /// and speeds, each other cell blocked with probability 1/4.
-    fn random_block_3d(rng: &mut crate::rng::Stream, count: usize) -> MoveProblem {
+    fn random_block_3d(rng: &mut crate::rules::rng::Stream, count: usize) -> MoveProblem {
         let mut cells = [0, 1, 2, 3, 4, 5, 6, 7];
         for i in (1..MAX_CELLS).rev() {
             cells.swap(i, rng.below(i as u32 + 1) as usize);
@@ -1827,7 +1827,7 @@ mod tests {
     /// with probability 1/4, each particle wanting its own cell moved along
     /// each axis with probability 1/2, and where that cell is blocked,
     /// staying (M5.4).
-    fn kernel_block_3d(rng: &mut crate::rng::Stream, count: usize) -> MoveProblem {
+    fn kernel_block_3d(rng: &mut crate::rules::rng::Stream, count: usize) -> MoveProblem {
         let mut problem = random_block_3d(rng, count);
         for i in 0..count {
             let want = problem.current[i] ^ rng.below(8) as u8;

@@ -41,43 +41,25 @@
 extern crate std;
 
 pub mod assign;
-mod cells;
-mod collision;
-mod desc;
-mod edit;
-mod emitter;
-mod error;
-mod force;
-mod hash;
-mod kernel;
-mod layout;
-mod obstacle;
-#[cfg(feature = "alloc")]
-mod owned;
-mod partition;
-mod quant;
-mod query;
-pub mod rng;
-mod snapshot;
+mod api;
+mod rules;
 mod step;
-#[cfg(target_has_atomic = "8")]
-mod tasks;
-mod vector;
-mod world;
+mod storage;
 
+pub use rules::rng;
 pub use assign::Method;
-pub use desc::{Boundary, Collisions, Description, Drag, Drift, Forces, Quantization, Vortex};
-pub use emitter::Emitter;
-pub use error::Error;
-pub use obstacle::{Shape, Surface};
+pub use api::desc::{Boundary, Collisions, Description, Drag, Drift, Forces, Quantization, Vortex};
+pub use api::error::Error;
 #[cfg(feature = "alloc")]
-pub use owned::WorldBox;
+pub use api::owned::WorldBox;
+pub use api::query::{Cell, Particle, Particles, RegionStats, Stats};
+pub use api::snapshot::{image_description, IMAGE_VERSION};
+pub use rules::emitter::Emitter;
+pub use rules::obstacle::{Shape, Surface};
 pub use step::Order;
 #[cfg(target_has_atomic = "8")]
-pub use tasks::{Host, MAX_TASKS};
-pub use query::{Cell, Particle, Particles, RegionStats, Stats};
-pub use snapshot::{image_description, IMAGE_VERSION};
-pub use world::{world_bytes, World, WORLD_ALIGN};
+pub use step::tasks::{Host, MAX_TASKS};
+pub use storage::world::{world_bytes, World, WORLD_ALIGN};
 
 /// How many cases a test runs: `full` natively, `under_miri` under Miri,
 /// which interprets every operation and runs a few thousand times slower.

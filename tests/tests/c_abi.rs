@@ -992,7 +992,7 @@ fn parallel_step_misuse_from_c_is_refused() {
 /// thread's refused call) runs clean: no race reported, every check
 /// passed. The library itself is not instrumented (Rust needs a nightly
 /// rebuild of std for that); its tasks touch disjoint memory by
-/// construction (core/src/cells.rs). Skipped in the AddressSanitizer run,
+/// construction (core/src/storage/cells.rs). Skipped in the AddressSanitizer run,
 /// which cannot be combined with it.
 #[test]
 fn parallel_steps_from_c_run_clean_under_thread_sanitizer() {

@@ -8,17 +8,23 @@
 //! switches read once per block at most, and a world without them sends its
 //! blocks through the lean routines, which have no code for them.
 
-use crate::cells::Cells;
-use crate::layout::Layout;
-use crate::force::{Flow, ForceTerms};
-use crate::kernel::{Kernel, Shared, Writable};
-use crate::partition::Partition;
-use crate::quant::Quant;
-use crate::rng::StepKey;
-use crate::layout::{groups, view, Planes};
+
+pub(crate) mod kernel;
+pub(crate) mod partition;
 #[cfg(target_has_atomic = "8")]
-use crate::tasks::Host;
-use crate::world::{Counters, World};
+pub(crate) mod tasks;
+
+use crate::rules::force::{Flow, ForceTerms};
+use crate::rules::quant::Quant;
+use crate::rules::rng::StepKey;
+use crate::step::kernel::{Kernel, Shared, Writable};
+use crate::step::partition::Partition;
+use crate::storage::cells::Cells;
+use crate::storage::layout::Layout;
+use crate::storage::layout::{groups, view, Planes};
+#[cfg(target_has_atomic = "8")]
+use crate::step::tasks::Host;
+use crate::storage::world::{Counters, World};
 
 /// The block order of a step. Blocks are independent (M3, M8); the reverse
 /// order exists so tests can show that the result does not depend on it.
@@ -137,7 +143,7 @@ impl World {
     /// One step, its sweep run whole or, with `split`, as tasks (M11).
     fn step_split(&mut self, route: Route, split: Split<'_>) {
         self.emit();
-        crate::quant::with_quant!(self.head.desc.quantization, Q => {
+        crate::rules::quant::with_quant!(self.head.desc.quantization, Q => {
             match self.head.desc.dim {
                 #[cfg(feature = "dim3")]
                 3 => run::<Q, 3, 8>(self, route, split),
@@ -216,7 +222,7 @@ impl World {
             // A build without obstacles has no surface entry to slice.
             surface: if cfg!(feature = "obstacles") { &surface[..head.surfaces as usize] } else { &[] },
             mass_table,
-            push: crate::vector::nonzero(push).then_some(push),
+            push: crate::rules::vector::nonzero(push).then_some(push),
             terms,
             dt_q,
             drag: desc.has_drag().then(|| Flow {
@@ -227,9 +233,9 @@ impl World {
                 dim,
                 rate: desc.dt * desc.drag.rate,
             }),
-            moves: crate::quant::move_table_8(desc.drift),
+            moves: crate::rules::quant::move_table_8(desc.drift),
             #[cfg(not(feature = "small-step"))]
-            tops: crate::quant::move_tops_8(desc.drift),
+            tops: crate::rules::quant::move_tops_8(desc.drift),
             summed,
             plain,
             lanes: plain && !desc.has_contacts(),
@@ -280,7 +286,7 @@ fn run<Q: Quant, const D: usize, const CELLS: usize>(w: &mut World, route: Route
         };
         match split {
             #[cfg(target_has_atomic = "8")]
-            Some((max, host)) => crate::tasks::run(&shared.part, max, host, &sweep),
+            Some((max, host)) => crate::step::tasks::run(&shared.part, max, host, &sweep),
             _ => sweep(0..shared.part.block_rows()),
         }
     });

@@ -145,7 +145,7 @@ impl Stream {
     /// A uniform `f32` in `[0, 1)` on a grid of `2^-24`.
     #[inline]
     pub fn unit(&mut self) -> f32 {
-        crate::vector::small_to_f32(self.bits(24)) * (1.0 / 16_777_216.0)
+        crate::rules::vector::small_to_f32(self.bits(24)) * (1.0 / 16_777_216.0)
     }
 
     /// True with probability `p` (to within `2^-24`; `p >= 1` always true).

@@ -18,10 +18,10 @@
 
 use core::ops::Range;
 
-use crate::cells::Cells;
-use crate::desc::Boundary;
-use crate::layout::Layout;
-use crate::vector::normalise;
+use crate::api::desc::Boundary;
+use crate::rules::vector::normalise;
+use crate::storage::cells::Cells;
+use crate::storage::layout::Layout;
 
 /// Where a cell coordinate lands under the boundary rules of M4.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -39,18 +39,18 @@
 //!
 //! M5.1 draws nothing.
 
+use crate::api::desc::{Collisions, Description};
 use crate::assign::{assign_moves, bits, optimal_moves_2d, pick_move, Bits, Method, MoveProblem, PLACE_2D};
-use crate::cells::Cells;
-use crate::collision::{collide_limited, collide_pair, energy_neutral, pick_pair, random_unit, shares};
-use crate::desc::{Collisions, Description};
-use crate::force::{Flow, ForceTerms};
-use crate::obstacle::{reflect, surface_at, Surface};
-use crate::partition::{cells_at, resolve, BlockRow, Coords, BlockSink, Beyond, Index, Partition};
-use crate::quant::Quant;
-use crate::rng::{StepKey, Stream};
-use crate::vector::{dot, dot_of, normalise};
-use crate::layout::{mark, put_bit};
-use crate::world::{Counters, ENERGY_SCALE};
+use crate::rules::collision::{collide_limited, collide_pair, energy_neutral, pick_pair, random_unit, shares};
+use crate::rules::force::{Flow, ForceTerms};
+use crate::rules::obstacle::{reflect, surface_at, Surface};
+use crate::rules::quant::Quant;
+use crate::rules::rng::{StepKey, Stream};
+use crate::rules::vector::{dot, dot_of, normalise};
+use crate::step::partition::{cells_at, resolve, BlockRow, Coords, BlockSink, Beyond, Index, Partition};
+use crate::storage::cells::Cells;
+use crate::storage::layout::{mark, put_bit};
+use crate::storage::world::{Counters, ENERGY_SCALE};
 
 /// The description as a step's blocks read it: with `small-step` where it
 /// lies in the world's header (no copy to set up: less flash, a load more
@@ -379,14 +379,14 @@ fn clamp_counted<const D: usize>(x: &mut [f32; 3], scale: f32, m: f32, counters:
 }
 
 /// [`clamp_counted`] with `small-step`: not even the test inlined, and
-/// the clamp the one of [`crate::vector::clamp`], which emitters use too
+/// the clamp the one of [`crate::rules::vector::clamp`], which emitters use too
 /// (one copy serves every stage: less flash, a call per test). Its squared
 /// length sums all three components, the same number in 2D, where the
 /// third is 0.
 #[cfg(feature = "small-step")]
 #[inline(never)]
 fn clamp_counted<const D: usize>(x: &mut [f32; 3], scale: f32, m: f32, counters: &mut Counters) {
-    if let Some(s2) = crate::vector::clamp(x, scale) {
+    if let Some(s2) = crate::rules::vector::clamp(x, scale) {
         count_clamp(s2, scale, m, counters);
     }
 }
@@ -397,7 +397,7 @@ fn clamp_counted<const D: usize>(x: &mut [f32; 3], scale: f32, m: f32, counters:
 #[cold]
 #[inline(never)]
 fn clamp_and_count(x: [f32; 3], s2: f32, scale: f32, m: f32, counters: &mut Counters) -> [f32; 3] {
-    let (x, s2) = crate::vector::clamp_long(x, s2, scale);
+    let (x, s2) = crate::rules::vector::clamp_long(x, s2, scale);
     count_clamp(s2, scale, m, counters);
     x
 }
@@ -407,11 +407,11 @@ fn clamp_and_count(x: [f32; 3], s2: f32, scale: f32, m: f32, counters: &mut Coun
 /// speed, and the kinetic energy it removed.
 #[inline(always)]
 fn count_clamp(s2: f32, scale: f32, m: f32, counters: &mut Counters) {
-    let s2 = crate::vector::div(s2, scale * scale);
+    let s2 = crate::rules::vector::div(s2, scale * scale);
     counters.clamps += 1;
     // f32 and a saturating cast: no f64 or 128-bit arithmetic, which small
     // cores emulate; f32's 24 bits are far finer than the statistic needs.
-    let fixed = crate::vector::saturating_u64(0.5 * m * (s2 - 1.0) * ENERGY_SCALE as f32);
+    let fixed = crate::rules::vector::saturating_u64(0.5 * m * (s2 - 1.0) * ENERGY_SCALE as f32);
     counters.clamp_energy = counters.clamp_energy.saturating_add(fixed);
 }
 
@@ -483,7 +483,7 @@ fn reflect_off<const D: usize>(sh: &Shared<'_>, x: [f32; 3], c: usize, to: Wante
             *a += ((c >> k) & 1) as isize - ((t >> k) & 1) as isize;
         }
         let back = back_normal::<D>(c, t);
-        if dot(n, back) > 0.0 && crate::obstacle::axis_move_free(if cfg!(feature = "obstacles") { sh.obstacle } else { &[] }, sh.n, &sh.desc.boundary, at, x, D) {
+        if dot(n, back) > 0.0 && crate::rules::obstacle::axis_move_free(if cfg!(feature = "obstacles") { sh.obstacle } else { &[] }, sh.n, &sh.desc.boundary, at, x, D) {
             return None;
         }
         back
@@ -1133,7 +1133,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
             };
             // A force that changes nothing is no step 1: a zero-valued part
             // gives the same world as a world without it (M9).
-            if crate::vector::nonzero(dv) {
+            if crate::rules::vector::nonzero(dv) {
                 self.push(&mut b, c, dv, mass_of(c));
             }
         }
@@ -1147,7 +1147,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
                 let u = flow.at(sh.part.cell_coords(row, [xs[c & 1], 0, 0], c), cell(c));
                 let mut x = b.velocity(c);
                 for k in 0..D {
-                    x[k] = crate::vector::div(x[k] + a * u[k], 1.0 + a);
+                    x[k] = crate::rules::vector::div(x[k] + a * u[k], 1.0 + a);
                 }
                 clamp_counted::<D>(&mut x, Q::SCALE, mass_of(c), &mut self.counters);
                 b.set(c, x);
@@ -1282,7 +1282,7 @@ impl<'a, Q: Quant, const D: usize, const CELLS: usize> BlockSink<'a> for Kernel<
 mod tests {
     use super::*;
     use crate::assign::digit;
-    use crate::rng::block_stream;
+    use crate::rules::rng::block_stream;
     use crate::{Description, World};
 
     #[test]
@@ -1356,7 +1356,7 @@ mod tests {
         // wall and open faces, every cell inside the box, every wish and
         // every sign of the components it does not cross. reflect_off
         // leaves out N.v >= 0 without obstacles on this.
-        use crate::desc::Boundary;
+        use crate::api::desc::Boundary;
         for dim in [2usize, 3] {
             let n = [4usize, 4, if dim == 3 { 4 } else { 1 }];
             let cells = 1usize << dim;

@@ -8,9 +8,9 @@
 
 use core::mem::{align_of, size_of};
 
-use crate::desc::Description;
-use crate::layout::{test_bit, view, view_counted, view_ref, Layout, Plain, Planes, Site};
 use crate::Error;
+use crate::api::desc::Description;
+use crate::storage::layout::{test_bit, view, view_counted, view_ref, Layout, Plain, Planes, Site};
 
 /// Counters the step keeps. All integers (clamped energy in 2^-32 units),
 /// so they add up to the same bits in any block order (M8).
@@ -214,7 +214,7 @@ impl World {
         let l = self.head.layout;
         let mut rest: &mut [u8] = &mut self.mem;
         let mut at = 0usize;
-        let mut take = |p: crate::layout::Plane| -> &mut [u8] {
+        let mut take = |p: crate::storage::layout::Plane| -> &mut [u8] {
             let r = core::mem::take(&mut rest);
             let (_, r) = r.split_at_mut(p.off - at);
             let (mine, r) = r.split_at_mut(p.len);
@@ -245,13 +245,13 @@ impl World {
         (&mut self.head, planes)
     }
 
-    pub(crate) fn plane<T: Plain>(&self, p: crate::layout::Plane) -> &[T] {
+    pub(crate) fn plane<T: Plain>(&self, p: crate::storage::layout::Plane) -> &[T] {
         view_ref(self.plane_bytes(p))
     }
 
     /// The bytes of plane `p`: the part of [`World::plane`] that does not
     /// depend on the type, so that it exists once.
-    pub(crate) fn plane_bytes(&self, p: crate::layout::Plane) -> &[u8] {
+    pub(crate) fn plane_bytes(&self, p: crate::storage::layout::Plane) -> &[u8] {
         &self.mem[p.off..p.off + p.len]
     }
 

@@ -6,11 +6,11 @@
 
 use core::mem::{align_of, size_of};
 
-use crate::cells::Cells;
-use crate::desc::{finite, mass, restitution, Boundary, Description, Quantization};
-use crate::emitter::Slot;
-use crate::obstacle::Surface;
 use crate::Error;
+use crate::api::desc::{finite, mass, restitution, Boundary, Description, Quantization};
+use crate::rules::emitter::Slot;
+use crate::rules::obstacle::Surface;
+use crate::storage::cells::Cells;
 
 /// Marks plain data that any bit pattern makes valid, so planes of it can be
 /// viewed in the world's bytes.
@@ -213,7 +213,7 @@ impl Layout {
         if d.drag.rate < 0.0 {
             return Err(Error::BadDrag);
         }
-        if !crate::force::slow(d.drag.wind[..dim].iter().copied()) {
+        if !crate::rules::force::slow(d.drag.wind[..dim].iter().copied()) {
             return Err(Error::SpeedRange);
         }
         if d.drag.vortex && d.drag.rate > 0.0 && d.vortex.core_radius <= 0.0 {
@@ -275,8 +275,8 @@ impl Layout {
             per_cell(4, d.forces.potential)?,
             per_cell(dim * 4, d.drag.field)?,
             if d.per_particle_mass { d.mass_classes as usize * 4 } else { 0 },
-            mul(d.surface_capacity as usize * usize::from(d.obstacles), size_of::<crate::obstacle::Surface>())?,
-            mul(d.emitter_capacity as usize, size_of::<crate::emitter::Slot>())?,
+            mul(d.surface_capacity as usize * usize::from(d.obstacles), size_of::<crate::rules::obstacle::Surface>())?,
+            mul(d.emitter_capacity as usize, size_of::<crate::rules::emitter::Slot>())?,
         ];
         let mut plane = lens.map(|len| Plane { off: 0, len });
         let mut at = 0usize;
@@ -334,7 +334,7 @@ pub(crate) struct Site {
 /// step does not skip them (M3). `summary_words` words per row.
 ///
 /// With `small-step` nothing: that build's sweep reads neither
-/// ([`crate::partition::Partition::sweep_band`]).
+/// ([`crate::step::partition::Partition::sweep_band`]).
 #[inline]
 pub(crate) fn mark(rows: Cells<'_, u8>, words: Cells<'_, u64>, summary_words: usize, row: usize, x: usize) {
     if cfg!(feature = "small-step") {

@@ -1,10 +1,10 @@
 //! What a world can be asked: a cell, every particle, densities for a
 //! texture, statistics (M10), and the particles and motion inside a box.
 
-use crate::layout::Layout;
-use crate::quant::{with_quant, Quant};
-use crate::world::{World, ENERGY_SCALE};
 use crate::Error;
+use crate::rules::quant::{with_quant, Quant};
+use crate::storage::layout::Layout;
+use crate::storage::world::{World, ENERGY_SCALE};
 
 /// One particle as the queries report it.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -1,7 +1,7 @@
 //! Particle-particle collision (M5.2, eqs. 7-8).
 
-use crate::rng::Stream;
-use crate::vector::{div, dot_of, normalise, small_to_f32};
+use crate::rules::rng::Stream;
+use crate::rules::vector::{div, dot_of, normalise, small_to_f32};
 
 /// Cell pairs of a block, in a fixed order: `PAIRS_2D` has the C(4,2) = 6
 /// pairs of a 2D block, `PAIRS_3D` the C(8,2) = 28 of a 3D one. M5.2 picks
@@ -97,7 +97,7 @@ pub(crate) fn random_unit<const D: usize>(rng: &mut Stream) -> [f32; 3] {
         let v = [coord(xy & 0xffff), coord(xy >> 16), z];
         let r2 = dot_of::<D>(v, v);
         if r2 > 1.0 / 64.0 && r2 <= 1.0 {
-            let inv = div(1.0, crate::vector::sqrt(r2));
+            let inv = div(1.0, crate::rules::vector::sqrt(r2));
             return v.map(|c| c * inv);
         }
     }
@@ -125,7 +125,7 @@ pub(crate) fn shares(ma: f32, mb: f32) -> (f32, f32) {
 #[inline]
 pub(crate) fn collide_pair<const D: usize>(va: [f32; 3], vb: [f32; 3], (sa, sb): (f32, f32), e: f32, r: [f32; 3]) -> ([f32; 3], [f32; 3]) {
     let rel = [va[0] - vb[0], va[1] - vb[1], va[2] - vb[2]];
-    let speed = e * crate::vector::sqrt(dot_of::<D>(rel, rel));
+    let speed = e * crate::rules::vector::sqrt(dot_of::<D>(rel, rel));
     let mut a = [0.0; 3];
     let mut b = [0.0; 3];
     for k in 0..D {
@@ -186,7 +186,7 @@ pub(crate) fn energy_neutral<const D: usize>(a: [f32; 3], b: [f32; 3], (sa, sb):
     let rel = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
     let kinetic = sa * sb * dot_of::<D>(rel, rel);
     let lost = sa * gain(a) + sb * gain(b);
-    let l = if kinetic > lost { crate::vector::sqrt(1.0 - div(lost, kinetic)) } else { 0.0 };
+    let l = if kinetic > lost { crate::rules::vector::sqrt(1.0 - div(lost, kinetic)) } else { 0.0 };
     let mut out = (a, b);
     for k in 0..D {
         let v0 = sa * a[k] + sb * b[k];
@@ -203,8 +203,8 @@ pub(crate) const SPEED_LIMIT_TRIES: u32 = 16;
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::rng::block_stream;
-    use crate::vector::dot;
+    use crate::rules::rng::block_stream;
+    use crate::rules::vector::dot;
 
     #[test]
     fn pair_tables_list_each_pair_once() {

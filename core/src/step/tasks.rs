@@ -19,8 +19,8 @@ use core::cell::UnsafeCell;
 use core::ops::Range;
 use core::sync::atomic::{AtomicU8, Ordering};
 
-use crate::partition::Partition;
-use crate::world::Counters;
+use crate::step::partition::Partition;
+use crate::storage::world::Counters;
 
 /// The most tasks one step is split into.
 pub const MAX_TASKS: usize = 64;

@@ -39,16 +39,16 @@
 
 use core::mem::size_of;
 
-use crate::assign::Method;
-use crate::cells::Cells;
-use crate::desc::{Boundary, Collisions, Description, Drag, Drift, Forces, Quantization, Vortex};
-use crate::edit::storable;
-use crate::emitter::{checked, Emitter, Slot};
-use crate::layout::{mark, Layout};
-use crate::obstacle::Surface;
-use crate::quant::{with_quant, Quant};
-use crate::world::{Counters, World};
 use crate::Error;
+use crate::api::desc::{Boundary, Collisions, Description, Drag, Drift, Forces, Quantization, Vortex};
+use crate::api::edit::storable;
+use crate::assign::Method;
+use crate::rules::emitter::{checked, Emitter, Slot};
+use crate::rules::obstacle::Surface;
+use crate::rules::quant::{with_quant, Quant};
+use crate::storage::cells::Cells;
+use crate::storage::layout::{mark, Layout};
+use crate::storage::world::{Counters, World};
 
 /// The first eight bytes of every image.
 const MAGIC: [u8; 8] = *b"MPCASNAP";
@@ -564,14 +564,14 @@ fn check(img: &Image<'_>) -> Result<(), Error> {
     if !floats(img.field) || !floats(img.potential) || !floats(img.wind) {
         return bad;
     }
-    if !(0..img.wind.len() / 4).step_by(dim).all(|i| crate::force::slow((i..i + dim).map(|k| float(img.wind, k)))) {
+    if !(0..img.wind.len() / 4).step_by(dim).all(|i| crate::rules::force::slow((i..i + dim).map(|k| float(img.wind, k)))) {
         return bad;
     }
 
     // The mass table: distinct valid masses, class 0 the description's.
     let table = |i: usize| f32::from_bits(le_u32(img.mass_table, i));
     for i in 0..img.masses {
-        if crate::desc::mass(table(i)).is_err() || (0..i).any(|j| table(j).to_bits() == table(i).to_bits()) {
+        if crate::api::desc::mass(table(i)).is_err() || (0..i).any(|j| table(j).to_bits() == table(i).to_bits()) {
             return bad;
         }
     }
@@ -595,11 +595,11 @@ fn check(img: &Image<'_>) -> Result<(), Error> {
             return bad;
         }
         // normalise() leaves |N|^2 within a few 1e-7 of 1; NaN is not unit.
-        let unit = (crate::vector::dot(s.normal, s.normal) - 1.0).abs() <= 1e-4;
+        let unit = (crate::rules::vector::dot(s.normal, s.normal) - 1.0).abs() <= 1e-4;
         if !unit || (dim == 2 && s.normal[2] != 0.0) {
             return bad;
         }
-        if crate::desc::restitution(s.restitution).is_err() || s.from_mask > 1 {
+        if crate::api::desc::restitution(s.restitution).is_err() || s.from_mask > 1 {
             return bad;
         }
     }

@@ -1,9 +1,9 @@
 //! The scene description: what a world uses (M9), checked in full before any
 //! memory is touched, and the memory layout that follows from it.
 
-use crate::assign::Method;
-use crate::layout::Layout;
 use crate::Error;
+use crate::assign::Method;
+use crate::storage::layout::Layout;
 
 /// What happens at one face of the domain (M4).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]

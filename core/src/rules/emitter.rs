@@ -6,13 +6,13 @@
 //! counted as shortfall. Draws come from the emitter's own stream
 //! `(seed, step, emitter index)` (M8).
 
-use crate::collision::random_unit;
-use crate::desc::finite;
-use crate::rng::{StepKey, Stream};
-use crate::vector::clamp;
-use crate::layout::{view_counted_ref, Plain};
-use crate::world::World;
 use crate::Error;
+use crate::api::desc::finite;
+use crate::rules::collision::random_unit;
+use crate::rules::rng::{StepKey, Stream};
+use crate::rules::vector::clamp;
+use crate::storage::layout::{view_counted_ref, Plain};
+use crate::storage::world::World;
 
 /// An emitter as the caller describes it.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -208,7 +208,7 @@ impl World {
             let mut rng = key.stream(i as u64);
             let whole = floor_rate(e.rate);
             // Casting saturates, so an absurd rate asks for u64::MAX.
-            let wanted = crate::vector::saturating_u64(whole).saturating_add(u64::from(rng.chance(e.rate - whole)));
+            let wanted = crate::rules::vector::saturating_u64(whole).saturating_add(u64::from(rng.chance(e.rate - whole)));
             if wanted == 0 {
                 continue;
             }
@@ -260,7 +260,7 @@ fn floor_rate(x: f32) -> f32 {
 }
 
 /// Calls `f` with every site of the emitter's region.
-fn each_site(l: crate::layout::Grid, e: &Emitter, mut f: impl FnMut(crate::layout::Site)) {
+fn each_site(l: crate::storage::layout::Grid, e: &Emitter, mut f: impl FnMut(crate::storage::layout::Site)) {
     for z in e.min[2] as usize..e.max[2] as usize {
         for y in e.min[1] as usize..e.max[1] as usize {
             for x in e.min[0] as usize..e.max[0] as usize {
@@ -278,7 +278,7 @@ fn spread_velocity(e: &Emitter, dim: usize, rng: &mut Stream) -> [f32; 3] {
         // A build without 3D has only 2D worlds: the 3D branch (and cbrtf)
         // is not linked into it.
         let (dir, radius) = if dim == 2 || !cfg!(feature = "dim3") {
-            (random_unit::<2>(rng), crate::vector::sqrt(rng.unit()))
+            (random_unit::<2>(rng), crate::rules::vector::sqrt(rng.unit()))
         } else {
             (random_unit::<3>(rng), libm::cbrtf(rng.unit()))
         };
@@ -297,7 +297,7 @@ mod tests {
     extern crate std;
 
     use super::*;
-    use crate::rng::block_stream;
+    use crate::rules::rng::block_stream;
 
     /// The check this replaced: `f64` throughout, exact but for the last
     /// roundings.

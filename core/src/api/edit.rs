@@ -2,12 +2,12 @@
 //! own), removing one, and the placement the emitters share (M1, M6, M9).
 //! Every edit checks everything before it changes anything.
 
-use crate::cells::Cells;
-use crate::layout::{mark, put_bit, Site};
-use crate::quant::{with_quant, Quant};
-use crate::query::Particle;
-use crate::world::World;
 use crate::Error;
+use crate::api::query::Particle;
+use crate::rules::quant::{with_quant, Quant};
+use crate::storage::cells::Cells;
+use crate::storage::layout::{mark, put_bit, Site};
+use crate::storage::world::World;
 
 /// Whether stored components `q`, in quanta (`scale` to a cell per step),
 /// lie within one quantum per axis of a velocity of length at most 1. Those
@@ -35,7 +35,7 @@ impl World {
     /// [`storable`]. That takes every `|v| <= 1` and every velocity a world
     /// reports, so a world can be rebuilt from what it reports.
     pub(crate) fn check_velocity(&self, v: [f32; 3]) -> Result<[f32; 3], Error> {
-        crate::desc::finite(&v)?;
+        crate::api::desc::finite(&v)?;
         let mut v = v;
         if self.dim() == 2 {
             v[2] = 0.0;
@@ -55,7 +55,7 @@ impl World {
     /// The mass table index of `m`, adding it if new. Nothing is changed on
     /// error.
     pub(crate) fn mass_index_of(&mut self, m: f32) -> Result<u8, Error> {
-        crate::desc::mass(m)?;
+        crate::api::desc::mass(m)?;
         if !self.head.desc.has_masses() {
             return if m == self.head.desc.mass { Ok(0) } else { Err(Error::NotEnabled) };
         }
@@ -90,7 +90,7 @@ impl World {
         if self.is_obstacle(s) {
             return Err(Error::CellObstacle);
         }
-        crate::desc::mass(m)?;
+        crate::api::desc::mass(m)?;
         // Last fallible step; it changes the world only when it succeeds.
         let index = self.mass_index_of(m)?;
         self.place_added(s, v, index);
@@ -102,7 +102,7 @@ impl World {
     /// stochastically from `rng` (M1). Not inlined into the step, whose
     /// frame would grow by it (64 bytes of a Cortex-M4F's stack).
     #[inline(never)]
-    pub(crate) fn place_emitted(&mut self, s: Site, v: [f32; 3], mass_index: u8, life: u16, rng: &mut crate::rng::Stream) {
+    pub(crate) fn place_emitted(&mut self, s: Site, v: [f32; 3], mass_index: u8, life: u16, rng: &mut crate::rules::rng::Stream) {
         self.place(s, v, mass_index, life, Some(rng));
     }
 
@@ -116,7 +116,7 @@ impl World {
     /// Writes a particle into a free cell. Components are rounded
     /// stochastically from `stream` when one is given (M1), else to nearest.
     #[inline(always)]
-    fn place(&mut self, s: Site, v: [f32; 3], mass_index: u8, life: u16, stream: Option<&mut crate::rng::Stream>) {
+    fn place(&mut self, s: Site, v: [f32; 3], mass_index: u8, life: u16, stream: Option<&mut crate::rules::rng::Stream>) {
         let d = self.dim();
         let summary_words = self.layout().summary_words;
         let per_mass = self.head.desc.has_masses();

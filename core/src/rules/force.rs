@@ -3,10 +3,10 @@
 //! every mass; the other terms are forces, divided by the particle's mass.
 //! And the flow that drag relaxes velocities towards (M5.1b).
 
-use crate::desc::{finite, Boundary, Vortex};
-use crate::layout::Planes;
-use crate::world::World;
 use crate::Error;
+use crate::api::desc::{finite, Boundary, Vortex};
+use crate::storage::layout::Planes;
+use crate::storage::world::World;
 
 /// The force terms of one step, read-only, for the general force path.
 pub(crate) struct ForceTerms<'a> {
@@ -47,7 +47,7 @@ impl ForceTerms<'_> {
         }
         let mut a = self.gravity;
         for k in 0..self.dim {
-            a[k] += crate::vector::div(f[k], m);
+            a[k] += crate::rules::vector::div(f[k], m);
         }
         a
     }
@@ -115,7 +115,7 @@ impl Flow<'_> {
 /// (`Layout::of`), and each axis at least 2.
 #[inline(always)]
 fn centre_of(pos: [usize; 3]) -> [f32; 2] {
-    [crate::vector::small_to_f32(pos[0] as u32) + 0.5, crate::vector::small_to_f32(pos[1] as u32) + 0.5]
+    [crate::rules::vector::small_to_f32(pos[0] as u32) + 0.5, crate::rules::vector::small_to_f32(pos[1] as u32) + 0.5]
 }
 
 /// The static Rankine vortex force at point `p`: tangential, of magnitude
@@ -132,8 +132,8 @@ pub(crate) fn vortex_force(v: &Vortex, p: [f32; 2]) -> [f32; 2] {
     let dx = p[0] - v.centre[0];
     let dy = p[1] - v.centre[1];
     // Neither is NaN: squares of finite numbers (Layout::of, set_vortex).
-    let r2 = crate::vector::larger(dx * dx + dy * dy, v.core_radius * v.core_radius);
-    let s = crate::vector::div(v.circulation, core::f32::consts::TAU * r2);
+    let r2 = crate::rules::vector::larger(dx * dx + dy * dy, v.core_radius * v.core_radius);
+    let s = crate::rules::vector::div(v.circulation, core::f32::consts::TAU * r2);
     let along = |d: f32| if d == 0.0 { 0.0 } else { d * s };
     [-along(dy), along(dx)]
 }

@@ -1,8 +1,8 @@
 //! The state hash: equal worlds hash equal on every target (M8), so the
 //! tests and the cross-target check compare worlds through it.
 
-use crate::quant::{with_quant, Quant};
-use crate::world::World;
+use crate::rules::quant::{with_quant, Quant};
+use crate::storage::world::World;
 
 impl World {
     /// A 64-bit FNV-1a hash over every particle's cell, stored velocity,

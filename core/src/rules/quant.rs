@@ -7,31 +7,31 @@
 //! stays one, and M5.3's move decision is an integer comparison of 16 random
 //! bits against a threshold of the stored component ([`Quant::move_limit`]).
 
-use crate::desc::Drift;
-use crate::rng::Stream;
+use crate::api::desc::Drift;
+use crate::rules::rng::Stream;
 
 /// Dispatches on the world's velocity storage type.
 macro_rules! with_quant {
     ($q:expr, $t:ident => $body:expr) => {
         match $q {
-            $crate::desc::Quantization::Bits8 => {
+            $crate::api::desc::Quantization::Bits8 => {
                 type $t = i8;
                 $body
             }
             #[cfg(feature = "q16")]
-            $crate::desc::Quantization::Bits16 => {
+            $crate::api::desc::Quantization::Bits16 => {
                 type $t = i16;
                 $body
             }
             #[cfg(not(feature = "q16"))]
-            $crate::desc::Quantization::Bits16 => unreachable!("refused by Layout::of"),
+            $crate::api::desc::Quantization::Bits16 => unreachable!("refused by Layout::of"),
         }
     };
 }
 pub(crate) use with_quant;
 
 /// A stored velocity component type.
-pub(crate) trait Quant: Copy + Default + Send + crate::layout::Plain + 'static {
+pub(crate) trait Quant: Copy + Default + Send + crate::storage::layout::Plain + 'static {
     /// Stored steps per unit speed.
     const SCALE: f32;
     fn from_int(q: i32) -> Self;
@@ -77,14 +77,14 @@ pub(crate) trait Quant: Copy + Default + Send + crate::layout::Plain + 'static {
         if Self::SCALE < 128.0 {
             // NaN as 0, which the sum below rounds to 0: a select, not a
             // branch, so that several components round in one vector.
-            let x = if crate::vector::is_nan(x) { 0.0 } else { x };
-            let y = (x + 128.0) + crate::vector::small_to_f32(r & 0xffff) * (1.0 / 65536.0);
+            let x = if crate::rules::vector::is_nan(x) { 0.0 } else { x };
+            let y = (x + 128.0) + crate::rules::vector::small_to_f32(r & 0xffff) * (1.0 / 65536.0);
             // x is in [-127, 127] (clamped, and not NaN), so y is finite
             // and in [1, 256): its integer part fits an i32. (A checked
             // cast would test for NaN and both bounds again.)
-            return crate::vector::whole_part(y) - 128;
+            return crate::rules::vector::whole_part(y) - 128;
         }
-        if crate::vector::is_nan(x) {
+        if crate::rules::vector::is_nan(x) {
             return 0;
         }
         let x = x * 65536.0;
@@ -227,10 +227,10 @@ impl Quant for i16 {
     fn move_limit(_: &[u16; 256], drift: Drift, q: i32) -> u32 {
         // 32,768 thresholds would not fit a table; f32 holds a/32767 to
         // 2^-24, far finer than the 2^-16 steps of the threshold.
-        let a = crate::vector::small_to_f32(q.unsigned_abs().min(32767)) * (1.0 / Self::SCALE);
+        let a = crate::rules::vector::small_to_f32(q.unsigned_abs().min(32767)) * (1.0 / Self::SCALE);
         let p = match drift {
             Drift::Paper => a,
-            Drift::Calibrated => crate::vector::div(2.0 * a, 1.0 + a),
+            Drift::Calibrated => crate::rules::vector::div(2.0 * a, 1.0 + a),
         };
         // 0 for q = 0 (which never moves: M5.3 asks only inward axes).
         ((p * 65536.0 + 0.5) as u32).saturating_sub(1)
@@ -240,7 +240,7 @@ impl Quant for i16 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::rng::block_stream;
+    use crate::rules::rng::block_stream;
 
     fn mean_of<Q: Quant>(x: f32, n: u32) -> f64 {
         let mut rng = block_stream(3, 0, 0);

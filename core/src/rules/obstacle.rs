@@ -9,13 +9,13 @@
 //! undefined is refused, and so is anything that does not fit: adding an
 //! obstacle either succeeds whole or changes nothing.
 
-use crate::cells::Cells;
-use crate::desc::{finite, restitution, Boundary};
-use crate::partition::{resolve, Beyond, Coords};
-use crate::vector::{dot, normalise};
-use crate::layout::{put_bit, row_words, test_bit, Plain};
-use crate::world::World;
 use crate::Error;
+use crate::api::desc::{finite, restitution, Boundary};
+use crate::rules::vector::{dot, normalise};
+use crate::step::partition::{resolve, Beyond, Coords};
+use crate::storage::cells::Cells;
+use crate::storage::layout::{put_bit, row_words, test_bit, Plain};
+use crate::storage::world::World;
 
 /// One obstacle surface cell.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

@@ -1,0 +1,10 @@
+//! The model's rules, each in a file named after it: what happens to the
+//! particles of a block, independent of where a world keeps them.
+
+pub(crate) mod collision;
+pub(crate) mod emitter;
+pub(crate) mod force;
+pub(crate) mod obstacle;
+pub(crate) mod quant;
+pub mod rng;
+pub(crate) mod vector;
