@@ -3,7 +3,7 @@
 
 use crate::Error;
 use crate::assign::Method;
-use crate::storage::layout::Layout;
+use crate::api::checks::{finite, mass, restitution, slow};
 
 /// What happens at one face of the domain (M4).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -226,13 +226,84 @@ impl Description {
         self
     }
 
-    /// Checks the whole description; the first problem found is returned.
-    pub fn validate(&self) -> Result<(), Error> {
-        Layout::of(self).map(|_| ())
+    /// Every check of a description but its memory plan, in the order
+    /// they are made ([`Description::validate`] adds the plan): dimension,
+    /// sizes and faces (M1, M4), then masses, restitutions, `dt` and every
+    /// force parameter, then the parts this build leaves out.
+    pub(crate) fn check(&self) -> Result<(), Error> {
+        let dim = self.dim as usize;
+        if dim != 2 && dim != 3 {
+            return Err(Error::BadDimension);
+        }
+        if dim == 3 && !cfg!(feature = "dim3") {
+            return Err(Error::Dim3Disabled);
+        }
+        for k in 0..dim {
+            let s = self.size[k];
+            if s == 0 {
+                return Err(Error::SizeZero);
+            }
+            if s % 2 != 0 {
+                return Err(Error::SizeOdd);
+            }
+            if self.boundary[k][0] != self.boundary[k][1]
+                && (self.boundary[k][0] == Boundary::Periodic || self.boundary[k][1] == Boundary::Periodic)
+            {
+                return Err(Error::PeriodicMismatch);
+            }
+        }
+        // M1: masses, restitutions, dt and every force parameter.
+        mass(self.mass)?;
+        restitution(self.restitution)?;
+        restitution(self.wall_restitution)?;
+        finite(&[self.dt])?;
+        if self.dt < 0.0 {
+            return Err(Error::NegativeDt);
+        }
+        finite(&self.gravity)?;
+        finite(&[self.vortex.centre[0], self.vortex.centre[1], self.vortex.core_radius, self.vortex.circulation])?;
+        if self.forces.vortex && self.vortex.core_radius <= 0.0 {
+            return Err(Error::BadVortex);
+        }
+        // M5.1b: a rate of 0 is off, and the wind is a velocity.
+        finite(&[self.drag.rate])?;
+        finite(&self.drag.wind)?;
+        if self.drag.rate < 0.0 {
+            return Err(Error::BadDrag);
+        }
+        if !slow(self.drag.wind[..dim].iter().copied()) {
+            return Err(Error::SpeedRange);
+        }
+        if self.drag.vortex && self.drag.rate > 0.0 && self.vortex.core_radius <= 0.0 {
+            return Err(Error::BadVortex);
+        }
+        if self.quantization == Quantization::Bits16 && !cfg!(feature = "q16") {
+            return Err(Error::Q16Disabled);
+        }
+        // A part the build left out: the step reads the description through
+        // accessors that give what the build keeps (`has_masses`,
+        // `built_forces`, `assignment`, ...), so a description they would
+        // change asks for something missing. One map of features to parts.
+        let kept = self.has_masses() == self.per_particle_mass
+            && self.has_obstacles() == self.obstacles
+            && self.built_forces() == self.forces
+            && self.has_drag() == (self.drag.rate > 0.0)
+            && (cfg!(feature = "fields") || !self.drag.field)
+            && self.assignment() == self.method
+            && self.collision_rule() == self.collisions
+            && self.has_contacts() == self.contacts
+            && self.has_energy_neutral() == self.energy_neutral;
+        if !kept {
+            return Err(Error::FeatureDisabled);
+        }
+        if self.per_particle_mass && !(1..=256).contains(&self.mass_classes) {
+            return Err(Error::CapacityRange);
+        }
+        Ok(())
     }
 
     /// `per_particle_mass`, false by construction in a build without the
-    /// feature `mass` ([`Layout::of`] refuses it there): the step and the
+    /// feature `mass` ([`Description::check`] refuses it there): the step and the
     /// edits test this, so such a build holds no code for masses.
     #[inline(always)]
     pub(crate) const fn has_masses(&self) -> bool {
@@ -247,7 +318,7 @@ impl Description {
     }
 
     /// `forces` with the terms this build leaves out false, as they are by
-    /// construction ([`Layout::of`] refuses them): the vortex needs the
+    /// construction ([`Description::check`] refuses them): the vortex needs the
     /// feature `vortex`, the force field and the potential `fields`. The
     /// step reads this, so a build without them holds no code for them.
     #[inline(always)]
@@ -265,7 +336,7 @@ impl Description {
     }
 
     /// `method`, [`Method::ExactFast`] by construction in a build without
-    /// the feature `all-methods` ([`Layout::of`] refuses the others there):
+    /// the feature `all-methods` ([`Description::check`] refuses the others there):
     /// the step reads this, so such a build holds no code for the others.
     #[inline(always)]
     pub(crate) const fn assignment(&self) -> Method {
@@ -273,7 +344,7 @@ impl Description {
     }
 
     /// `collisions`, [`Collisions::Paper`] by construction in a build
-    /// without the feature `collision-rules` ([`Layout::of`] refuses M5.2b
+    /// without the feature `collision-rules` ([`Description::check`] refuses M5.2b
     /// there), as [`Description::assignment`].
     #[inline(always)]
     pub(crate) const fn collision_rule(&self) -> Collisions {
@@ -293,20 +364,6 @@ impl Description {
     pub(crate) const fn has_energy_neutral(&self) -> bool {
         cfg!(feature = "collision-rules") && self.energy_neutral
     }
-}
-
-pub(crate) fn finite(values: &[f32]) -> Result<(), Error> {
-    if values.iter().all(|v| v.is_finite()) { Ok(()) } else { Err(Error::NotFinite) }
-}
-
-pub(crate) fn restitution(e: f32) -> Result<(), Error> {
-    finite(&[e])?;
-    if (0.0..=1.0).contains(&e) { Ok(()) } else { Err(Error::RestitutionRange) }
-}
-
-pub(crate) fn mass(m: f32) -> Result<(), Error> {
-    finite(&[m])?;
-    if m > 0.0 { Ok(()) } else { Err(Error::MassRange) }
 }
 
 #[cfg(test)]

@@ -35,7 +35,7 @@ impl World {
     /// [`storable`]. That takes every `|v| <= 1` and every velocity a world
     /// reports, so a world can be rebuilt from what it reports.
     pub(crate) fn check_velocity(&self, v: [f32; 3]) -> Result<[f32; 3], Error> {
-        crate::api::desc::finite(&v)?;
+        crate::api::checks::finite(&v)?;
         let mut v = v;
         if self.dim() == 2 {
             v[2] = 0.0;
@@ -55,7 +55,7 @@ impl World {
     /// The mass table index of `m`, adding it if new. Nothing is changed on
     /// error.
     pub(crate) fn mass_index_of(&mut self, m: f32) -> Result<u8, Error> {
-        crate::api::desc::mass(m)?;
+        crate::api::checks::mass(m)?;
         if !self.head.desc.has_masses() {
             return if m == self.head.desc.mass { Ok(0) } else { Err(Error::NotEnabled) };
         }
@@ -90,7 +90,7 @@ impl World {
         if self.is_obstacle(s) {
             return Err(Error::CellObstacle);
         }
-        crate::api::desc::mass(m)?;
+        crate::api::checks::mass(m)?;
         // Last fallible step; it changes the world only when it succeeds.
         let index = self.mass_index_of(m)?;
         self.place_added(s, v, index);
@@ -100,7 +100,7 @@ impl World {
 
     /// Writes an emitted particle into a free cell, its components rounded
     /// stochastically from `rng` (M1). Not inlined into the step, whose
-    /// frame would grow by it (64 bytes of a Cortex-M4F's stack).
+    /// frame would grow by it, on firmware stacks too.
     #[inline(never)]
     pub(crate) fn place_emitted(&mut self, s: Site, v: [f32; 3], mass_index: u8, life: u16, rng: &mut crate::rules::rng::Stream) {
         self.place(s, v, mass_index, life, Some(rng));

@@ -564,14 +564,14 @@ fn check(img: &Image<'_>) -> Result<(), Error> {
     if !floats(img.field) || !floats(img.potential) || !floats(img.wind) {
         return bad;
     }
-    if !(0..img.wind.len() / 4).step_by(dim).all(|i| crate::rules::force::slow((i..i + dim).map(|k| float(img.wind, k)))) {
+    if !(0..img.wind.len() / 4).step_by(dim).all(|i| crate::api::checks::slow((i..i + dim).map(|k| float(img.wind, k)))) {
         return bad;
     }
 
     // The mass table: distinct valid masses, class 0 the description's.
     let table = |i: usize| f32::from_bits(le_u32(img.mass_table, i));
     for i in 0..img.masses {
-        if crate::api::desc::mass(table(i)).is_err() || (0..i).any(|j| table(j).to_bits() == table(i).to_bits()) {
+        if crate::api::checks::mass(table(i)).is_err() || (0..i).any(|j| table(j).to_bits() == table(i).to_bits()) {
             return bad;
         }
     }
@@ -599,7 +599,7 @@ fn check(img: &Image<'_>) -> Result<(), Error> {
         if !unit || (dim == 2 && s.normal[2] != 0.0) {
             return bad;
         }
-        if crate::api::desc::restitution(s.restitution).is_err() || s.from_mask > 1 {
+        if crate::api::checks::restitution(s.restitution).is_err() || s.from_mask > 1 {
             return bad;
         }
     }
@@ -693,7 +693,7 @@ pub fn image_description(image: &[u8]) -> Result<Description, Error> {
 }
 
 impl World {
-    /// Bytes of the image [`World::save`] writes now: a fixed 248 bytes,
+    /// Bytes of the image [`World::save`] writes now: a fixed head and state,
     /// the occupancy and obstacle bit planes, a few bytes per particle,
     /// the force and wind planes, and the used entries of the tables (M12).
     pub fn snapshot_bytes(&self) -> usize {

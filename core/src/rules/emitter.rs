@@ -7,12 +7,10 @@
 //! `(seed, step, emitter index)` (M8).
 
 use crate::Error;
-use crate::api::desc::finite;
+use crate::api::checks::finite;
 use crate::rules::collision::random_unit;
-use crate::rules::rng::{StepKey, Stream};
+use crate::rules::rng::Stream;
 use crate::rules::vector::clamp;
-use crate::storage::layout::{view_counted_ref, Plain};
-use crate::storage::world::World;
 
 /// An emitter as the caller describes it.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -43,9 +41,6 @@ pub(crate) struct Slot {
     pub emitter: Emitter,
     pub mass_index: u32,
 }
-
-// SAFETY: u32 and f32 fields only, no padding, every bit pattern valid.
-unsafe impl Plain for Slot {}
 
 /// `e` as a world of `dim` dimensions, `n` cells per axis and, if
 /// `lifetimes`, an age plane stores it (2D drops the third axis), or why
@@ -80,7 +75,7 @@ pub(crate) fn checked(e: &mut Emitter, dim: usize, n: [usize; 3], lifetimes: boo
 /// `spread >= 0` (M6). In `f32` the sum would round 0.5 + 0.50000006 down
 /// to 1; in `f64`, as this was checked before, it still rounds a sum above
 /// 1 by less than about 1e-16 down to 1 (`[1, 2^-149, 0]` passed), and it
-/// cost a firmware over 2 KB of double-precision soft float. Integers
+/// cost a firmware double-precision soft float. Integers
 /// decide it instead, without error:
 ///
 /// - `spread >= 1`: over 1 exactly when `spread > 1` or `v != 0`;
@@ -163,91 +158,11 @@ impl Wide {
     }
 }
 
-impl World {
-    /// Adds an emitter and returns its index.
-    pub fn add_emitter(&mut self, mut e: Emitter) -> Result<usize, Error> {
-        checked(&mut e, self.dim(), self.layout().n, self.head.desc.lifetimes)?;
-        let used = self.head.emitters as usize;
-        // The capacity the plane was sized for (`Layout::of`), without a
-        // division by the slot's size.
-        if used >= self.head.desc.emitter_capacity as usize {
-            return Err(Error::EmitterTableFull);
-        }
-        let mass_index = u32::from(self.mass_index_of(e.mass)?);
-        let (head, p) = self.planes::<u8>();
-        p.emitters[used] = Slot { emitter: e, mass_index };
-        head.emitters += 1;
-        Ok(used)
-    }
-
-    /// Changes the rate of emitter `index`.
-    pub fn set_emitter_rate(&mut self, index: usize, rate: f32) -> Result<(), Error> {
-        finite(&[rate])?;
-        if rate < 0.0 {
-            return Err(Error::BadEmitter);
-        }
-        if index >= self.head.emitters as usize {
-            return Err(Error::OutOfBounds);
-        }
-        self.planes::<u8>().1.emitters[index].emitter.rate = rate;
-        Ok(())
-    }
-
-    /// The emitter table, as long as its capacity.
-    fn slots(&self) -> &[Slot] {
-        view_counted_ref(self.plane_bytes(self.layout().emitters()), self.head.desc.emitter_capacity as usize)
-    }
-
-    /// Runs every emitter once (M6), at the start of a step.
-    pub(crate) fn emit(&mut self) {
-        let (seed, step, dim) = (self.head.desc.seed, self.head.step, self.dim());
-        let key = StepKey::emitters(seed, step);
-        for i in 0..self.head.emitters as usize {
-            let slot: Slot = self.slots()[i];
-            let e = slot.emitter;
-            let mut rng = key.stream(i as u64);
-            let whole = floor_rate(e.rate);
-            // Casting saturates, so an absurd rate asks for u64::MAX.
-            let wanted = crate::rules::vector::saturating_u64(whole).saturating_add(u64::from(rng.chance(e.rate - whole)));
-            if wanted == 0 {
-                continue;
-            }
-            let grid = self.layout().grid();
-            // Cells, counted in machine words (not u64: small cores add
-            // those in pairs of instructions).
-            let mut free = 0usize;
-            each_site(grid, &e, |s| free += usize::from(!self.occupied(s) && !self.is_obstacle(s)));
-            let placing = wanted.min(free as u64) as usize;
-            self.head.counters.shortfall = self.head.counters.shortfall.saturating_add(wanted - placing as u64);
-            let mut need = placing;
-            let mut left = free;
-            let mut chosen = |w: &mut World, s| {
-                if need == 0 || w.occupied(s) || w.is_obstacle(s) {
-                    return;
-                }
-                // Selection sampling: take this cell with chance need/left,
-                // which picks a uniform subset of `placing` free cells.
-                // `left` counts cells, so it fits the u32 of `below`.
-                let take = (rng.below(left as u32) as usize) < need;
-                left -= 1;
-                if take {
-                    need -= 1;
-                    let v = spread_velocity(&e, dim, &mut rng);
-                    w.place_emitted(s, v, slot.mass_index as u8, e.lifetime as u16, &mut rng);
-                }
-            };
-            each_site(grid, &e, |s| chosen(self, s));
-            // Saturating: an image (M12) may carry any count.
-            self.head.counters.emitted = self.head.counters.emitted.saturating_add(placing as u64);
-            self.head.counters.particles += placing as u64;
-        }
-    }
-}
 
 /// `floor(x)` for an `x` that is not negative (a rate: `checked`), by
 /// clearing the bits of its fraction: a few instructions where `floorf`
-/// is a library routine of some 100 bytes.
-fn floor_rate(x: f32) -> f32 {
+/// is a library routine.
+pub(crate) fn floor_rate(x: f32) -> f32 {
     let bits = x.to_bits();
     let exponent = (bits >> 23 & 0xff) as i32 - 127;
     if exponent < 0 {
@@ -259,20 +174,10 @@ fn floor_rate(x: f32) -> f32 {
     f32::from_bits(bits & !fraction)
 }
 
-/// Calls `f` with every site of the emitter's region.
-fn each_site(l: crate::storage::layout::Grid, e: &Emitter, mut f: impl FnMut(crate::storage::layout::Site)) {
-    for z in e.min[2] as usize..e.max[2] as usize {
-        for y in e.min[1] as usize..e.max[1] as usize {
-            for x in e.min[0] as usize..e.max[0] as usize {
-                f(l.site(x, y, z));
-            }
-        }
-    }
-}
 
 /// The emitter's velocity plus a uniform point of the disc or ball of radius
 /// `spread`.
-fn spread_velocity(e: &Emitter, dim: usize, rng: &mut Stream) -> [f32; 3] {
+pub(crate) fn spread_velocity(e: &Emitter, dim: usize, rng: &mut Stream) -> [f32; 3] {
     let mut v = e.velocity;
     if e.spread > 0.0 {
         // A build without 3D has only 2D worlds: the 3D branch (and cbrtf)

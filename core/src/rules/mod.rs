@@ -3,6 +3,7 @@
 
 pub(crate) mod collision;
 pub(crate) mod emitter;
+pub(crate) mod faces;
 pub(crate) mod force;
 pub(crate) mod obstacle;
 pub(crate) mod quant;

@@ -49,7 +49,7 @@ pub(crate) fn larger(a: f32, b: f32) -> f32 {
 
 /// `x as u64` (toward zero; NaN and below 0 give 0, from 2^64 on
 /// `u64::MAX`) from the bits of `x`: on 32-bit cores the cast is a library
-/// routine of some 80 bytes.
+/// routine.
 pub(crate) fn saturating_u64(x: f32) -> u64 {
     let bits = x.to_bits();
     // Negative (sign set) or NaN (above the bits of infinity): 0.
@@ -70,8 +70,7 @@ pub(crate) fn saturating_u64(x: f32) -> u64 {
 /// The square root, correctly rounded as IEEE 754 asks and as
 /// `libm::sqrtf` gives it. On Arm cores with a hard-float unit (the
 /// `eabihf` targets: VFP, which has the instruction) one `vsqrt.f32`,
-/// where libm is a software routine of some 260 bytes and a 256-byte
-/// table; elsewhere libm's (an instruction too where libm has one).
+/// where libm is a software routine with a table of its own; elsewhere libm's (an instruction too where libm has one).
 #[inline(always)]
 pub(crate) fn sqrt(x: f32) -> f32 {
     #[cfg(all(target_arch = "arm", target_abi = "eabihf"))]
@@ -102,7 +101,7 @@ pub(crate) fn sqrt(x: f32) -> f32 {
 
 /// The square root of a non-negative `x` digit by digit in integers,
 /// correctly rounded: for Arm cores without a floating-point unit, where
-/// libm's routine and its table take some 580 bytes. `x` is never
+/// libm's routine and its table are larger. `x` is never
 /// negative or NaN here (squared lengths, uniform draws); for those it
 /// gives NaN, for -0 and +infinity `x`. The tests hold it to libm bit for
 /// bit. Hard-float Arm cores take the instruction instead.
@@ -160,7 +159,7 @@ fn bitwise_sqrt(x: f32) -> f32 {
 }
 
 /// `a / b`, correctly rounded as IEEE 754 asks. On Arm cores without a
-/// floating-point unit [`bitwise_div`], some 530 bytes smaller than the
+/// floating-point unit [`bitwise_div`], smaller than the
 /// Rust runtime's `__divsf3` it replaces; elsewhere the division itself
 /// (an instruction, or the runtime's routine where the core has none).
 #[inline(always)]
@@ -241,7 +240,7 @@ fn bitwise_div(a: f32, b: f32) -> f32 {
         // below zero (the doubled remainder under mb: both are below 2^25,
         // so the sign bit tells), else 0. The quotient's next bit is 1
         // plus borrow, and mb is added back where it borrowed. Without a
-        // branch: 12 instructions a bit on the M0 rather than 15.
+        // branch: fewer instructions a bit on the M0.
         let less = (rest << 1).wrapping_sub(mb);
         let borrow = ((less as i32) >> 31) as u32;
         q = (q << 1 | 1).wrapping_add(borrow);

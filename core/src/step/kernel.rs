@@ -39,7 +39,7 @@
 //!
 //! M5.1 draws nothing.
 
-use crate::api::desc::{Collisions, Description};
+use crate::api::desc::{Boundary, Collisions, Description};
 use crate::assign::{assign_moves, bits, optimal_moves_2d, pick_move, Bits, Method, MoveProblem, PLACE_2D};
 use crate::rules::collision::{collide_limited, collide_pair, energy_neutral, pick_pair, random_unit, shares};
 use crate::rules::force::{Flow, ForceTerms};
@@ -47,9 +47,10 @@ use crate::rules::obstacle::{reflect, surface_at, Surface};
 use crate::rules::quant::Quant;
 use crate::rules::rng::{StepKey, Stream};
 use crate::rules::vector::{dot, dot_of, normalise};
-use crate::step::partition::{cells_at, resolve, BlockRow, Coords, BlockSink, Beyond, Index, Partition};
+use crate::rules::faces::{resolve, Beyond, Coords};
+use crate::step::partition::{cells_at, BlockRow, BlockSink, Index, Partition};
 use crate::storage::cells::Cells;
-use crate::storage::layout::{mark, put_bit};
+use crate::storage::layout::{mark, put_bit, row_words, test_bit};
 use crate::storage::world::{Counters, ENERGY_SCALE};
 
 /// The description as a step's blocks read it: with `small-step` where it
@@ -449,7 +450,7 @@ fn reflect_off<const D: usize>(sh: &Shared<'_>, x: [f32; 3], c: usize, to: Wante
     let (n, e) = surface.unwrap_or_else(|| match surface_at(table, to.site as u32) {
         // Component by component: a copy of the array through the
         // reference is a `memmove` call at opt-level z, the only one in a
-        // firmware build (1.5 KB of flash).
+        // firmware build.
         Some(s) => ([s.normal[0], s.normal[1], s.normal[2]], s.restitution),
         // Unreachable for obstacles added through the API (every cell
         // next to a free one has an entry): the direction back to the
@@ -483,7 +484,7 @@ fn reflect_off<const D: usize>(sh: &Shared<'_>, x: [f32; 3], c: usize, to: Wante
             *a += ((c >> k) & 1) as isize - ((t >> k) & 1) as isize;
         }
         let back = back_normal::<D>(c, t);
-        if dot(n, back) > 0.0 && crate::rules::obstacle::axis_move_free(if cfg!(feature = "obstacles") { sh.obstacle } else { &[] }, sh.n, &sh.desc.boundary, at, x, D) {
+        if dot(n, back) > 0.0 && axis_move_free(if cfg!(feature = "obstacles") { sh.obstacle } else { &[] }, sh.n, &sh.desc.boundary, at, x, D) {
             return None;
         }
         back
@@ -491,6 +492,27 @@ fn reflect_off<const D: usize>(sh: &Shared<'_>, x: [f32; 3], c: usize, to: Wante
     let mut x = reflect(x, n, e); // eq. 9
     clamp_counted::<D>(&mut x, scale, m, counters);
     Some(x)
+}
+
+/// M5.4: whether the particle at `at` (raw coordinates, resolved across the
+/// faces `boundary` of a domain of `n` cells per axis) with velocity `v`
+/// has a cell to go to along a single axis `k` of its velocity (towards
+/// `sign(v_k)`, `v_k != 0`, one of the first `dim` axes) that is neither an
+/// obstacle (bit plane `obstacle`) nor beyond a wall. Such a particle can
+/// always move on later, so refusing it one move leaves it never stuck.
+pub(crate) fn axis_move_free(obstacle: &[u64], n: [usize; 3], boundary: &[[Boundary; 2]; 3], at: Coords, v: [f32; 3], dim: usize) -> bool {
+    (0..dim).any(|k| {
+        if v[k] == 0.0 {
+            return false;
+        }
+        let mut to = at;
+        to[k] += if v[k] > 0.0 { 1 } else { -1 };
+        match resolve(n, boundary, to) {
+            Beyond::Wall(_) => false,
+            Beyond::Open => true,
+            Beyond::Inside(p) => !test_bit(obstacle, (p[1] + n[1] * p[2]) * row_words(n[0]) * 64 + p[0]),
+        }
+    })
 }
 
 /// M5.6 by `method` (not 2D exact-fast, which [`Kernel::assign`] takes to
@@ -1356,7 +1378,6 @@ mod tests {
         // wall and open faces, every cell inside the box, every wish and
         // every sign of the components it does not cross. reflect_off
         // leaves out N.v >= 0 without obstacles on this.
-        use crate::api::desc::Boundary;
         for dim in [2usize, 3] {
             let n = [4usize, 4, if dim == 3 { 4 } else { 1 }];
             let cells = 1usize << dim;

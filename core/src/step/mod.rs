@@ -9,6 +9,7 @@
 //! blocks through the lean routines, which have no code for them.
 
 
+pub(crate) mod emit;
 pub(crate) mod kernel;
 pub(crate) mod partition;
 #[cfg(target_has_atomic = "8")]
@@ -165,7 +166,7 @@ impl World {
         visit: impl FnOnce(&Shared<'_>, Writable<'_, Q, D>, bool) -> Counters,
     ) {
         // The shared data read where `setup` wrote it (moved out, it would
-        // be a copy of some 280 bytes).
+        // be a copy of all of it).
         let s = self.setup(route, Q::SCALE);
         let velocity = Cells::new(groups(view::<Q>(s.velocity)));
         let planes = Writable { occupancy: s.occupancy, rows: s.rows, words: s.words, velocity, mass_index: s.mass_index, life: s.life };
@@ -184,8 +185,8 @@ impl World {
         // Without `small-step` the blocks read a copy of the description
         // (`StepDescription`), taken here, before the header is borrowed:
         // a copy made through the borrow would be a `memmove` (the
-        // compiler cannot tell that the two do not overlap), a routine of
-        // 1.3 KB on a small core.
+        // compiler cannot tell that the two do not overlap), a large routine
+        // on a small core.
         #[cfg(not(feature = "small-step"))]
         let copy = self.head.desc;
         let (head, p) = self.planes::<u8>();

@@ -19,68 +19,9 @@
 use core::ops::Range;
 
 use crate::api::desc::Boundary;
-use crate::rules::vector::normalise;
 use crate::storage::cells::Cells;
 use crate::storage::layout::Layout;
 
-/// Where a cell coordinate lands under the boundary rules of M4.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) enum Beyond {
-    /// A cell of the domain, wrapped across periodic faces.
-    Inside([usize; 3]),
-    /// Beyond a wall: an obstacle with this unit inward normal (the
-    /// normalised sum of the walls' normals where walls meet). A cell beyond
-    /// both a wall and an open face is wall.
-    Wall([f32; 3]),
-    /// Beyond open faces only: a particle sent there leaves.
-    Open,
-}
-
-/// A cell's coordinates, possibly beyond a face: signed machine words,
-/// wide enough for the `-n <= c < 2n` that [`resolve`] takes. On 32-bit
-/// cores `Layout::of` keeps a world's bytes below 2^30 and every cell holds
-/// at least two bytes of velocity, so no axis reaches 2^29 cells and `2n`
-/// fits an `i32`; 64-bit integers would be pairs of registers there, and
-/// library calls.
-pub(crate) type Coords = [isize; 3];
-
-/// M4: what lies at the (possibly out-of-domain) cell coordinates `c` of a
-/// domain of `n` cells per axis with faces `boundary`. Axes beyond the
-/// world's dimension have `n = 1` and `c = 0`. Every caller asks for a
-/// neighbour of a cell, so each coordinate lies within one domain length
-/// of the domain (`-n <= c < 2n`): a periodic face wraps it with one add
-/// (no 64-bit division, which small cores call a library routine for).
-pub(crate) fn resolve(n: [usize; 3], boundary: &[[Boundary; 2]; 3], c: Coords) -> Beyond {
-    let mut out = [0usize; 3];
-    let mut wall = [0.0f32; 3];
-    let (mut is_wall, mut is_open) = (false, false);
-    for k in 0..3 {
-        let nk = n[k] as isize;
-        if (0..nk).contains(&c[k]) {
-            out[k] = c[k] as usize;
-            continue;
-        }
-        let high = c[k] >= nk;
-        match boundary[k][usize::from(high)] {
-            Boundary::Periodic => {
-                debug_assert!((-nk..2 * nk).contains(&c[k]), "{c:?} beyond one domain length");
-                out[k] = if high { c[k] - nk } else { c[k] + nk } as usize;
-            }
-            Boundary::Wall => {
-                is_wall = true;
-                wall[k] = if high { -1.0 } else { 1.0 };
-            }
-            Boundary::Open => is_open = true,
-        }
-    }
-    if is_wall {
-        Beyond::Wall(normalise(wall).unwrap_or([0.0; 3]))
-    } else if is_open {
-        Beyond::Open
-    } else {
-        Beyond::Inside(out)
-    }
-}
 
 /// One axis of a step's partition.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -434,7 +375,7 @@ impl Partition {
     /// [`Partition::empty_run`] in 2D, out of line: one copy for both
     /// velocity widths. In 3D it stays inline, where most rows of a world
     /// are empty and a call for each run of them would cost a scene such as
-    /// water about 14 instructions a processed block.
+    /// water a measurable share of its blocks' instructions.
     #[inline(never)]
     fn empty_run_2d(&self, rows: Cells<'_, u8>, at: [usize; 2], reverse: bool, room: usize) -> usize {
         self.empty_run::<1>(rows, at, reverse, room)
@@ -564,7 +505,7 @@ impl Partition {
                     // half block its index is one more (`half` implies
                     // offset 1). One call for both offsets: the block
                     // routines are inlined here, and a call in each branch
-                    // copied them twice (49 KB of libmpca.so).
+                    // copied them twice into libmpca.so.
                     sink.visit(row, plan, (2 * pair + self.offset) as isize, pair + usize::from(half), occ);
                 }
             }

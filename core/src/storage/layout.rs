@@ -7,7 +7,7 @@
 use core::mem::{align_of, size_of};
 
 use crate::Error;
-use crate::api::desc::{finite, mass, restitution, Boundary, Description, Quantization};
+use crate::api::desc::{Description, Quantization};
 use crate::rules::emitter::Slot;
 use crate::rules::obstacle::Surface;
 use crate::storage::cells::Cells;
@@ -29,6 +29,10 @@ unsafe impl Plain for f32 {}
 // SAFETY: an array of plain values is plain: no padding between elements,
 // and every element accepts every bit pattern.
 unsafe impl<T: Plain, const N: usize> Plain for [T; N] {}
+// SAFETY: u32 and f32 fields, no padding, every bit pattern valid.
+unsafe impl Plain for crate::rules::obstacle::Surface {}
+// SAFETY: u32 and f32 fields only, no padding, every bit pattern valid.
+unsafe impl Plain for crate::rules::emitter::Slot {}
 
 /// Views a plane of `T` as whole groups of `N` (a cell's `N` velocity
 /// components, say); a partial group at the end is left out.
@@ -61,7 +65,7 @@ pub(crate) fn view_ref<T: Plain>(bytes: &[u8]) -> &[T] {
 }
 
 /// `bytes` as values of `T`, whose plane [`Layout::of`] sized for `count`
-/// of them (the emitters: a structure of 56 bytes). With `small-step`
+/// of them (the emitters' table). With `small-step`
 /// (firmware) the first `count` (none where fewer fit), without the
 /// division by the size that [`view`] makes, which small cores call a
 /// routine for; otherwise [`view`], the same values.
@@ -121,8 +125,8 @@ pub(crate) struct Layout {
     /// Every plane, in the order they lie in memory, read through the
     /// accessors below (`occupancy()`, ...): one array, which
     /// [`Layout::of`] fills in one loop. As named fields each plane was
-    /// built apart and then moved into the result, some 190 bytes of
-    /// copies on a Cortex-M0.
+    /// built apart and then moved into the result, copies that a
+    /// Cortex-M0 paid for.
     plane: [Plane; PLANES],
     pub total: usize,
 }
@@ -168,78 +172,15 @@ planes! {
 }
 
 impl Layout {
-    /// Validates `d` and plans its memory. Every size computation is checked,
-    /// so a description whose byte count would overflow is refused.
+    /// Checks `d` ([`Description::check`]) and plans its memory. Every
+    /// size computation is checked, so a description whose byte count would
+    /// overflow is refused.
     pub fn of(d: &Description) -> Result<Layout, Error> {
+        d.check()?;
         let dim = d.dim as usize;
-        if dim != 2 && dim != 3 {
-            return Err(Error::BadDimension);
-        }
-        if dim == 3 && !cfg!(feature = "dim3") {
-            return Err(Error::Dim3Disabled);
-        }
         let mut n = [1usize; 3];
         for k in 0..dim {
-            let s = d.size[k];
-            if s == 0 {
-                return Err(Error::SizeZero);
-            }
-            if s % 2 != 0 {
-                return Err(Error::SizeOdd);
-            }
-            n[k] = usize::try_from(s).map_err(|_| Error::TooLarge)?;
-            if d.boundary[k][0] != d.boundary[k][1]
-                && (d.boundary[k][0] == Boundary::Periodic || d.boundary[k][1] == Boundary::Periodic)
-            {
-                return Err(Error::PeriodicMismatch);
-            }
-        }
-        // M1: masses, restitutions, dt and every force parameter.
-        mass(d.mass)?;
-        restitution(d.restitution)?;
-        restitution(d.wall_restitution)?;
-        finite(&[d.dt])?;
-        if d.dt < 0.0 {
-            return Err(Error::NegativeDt);
-        }
-        finite(&d.gravity)?;
-        finite(&[d.vortex.centre[0], d.vortex.centre[1], d.vortex.core_radius, d.vortex.circulation])?;
-        if d.forces.vortex && d.vortex.core_radius <= 0.0 {
-            return Err(Error::BadVortex);
-        }
-        // M5.1b: a rate of 0 is off, and the wind is a velocity.
-        finite(&[d.drag.rate])?;
-        finite(&d.drag.wind)?;
-        if d.drag.rate < 0.0 {
-            return Err(Error::BadDrag);
-        }
-        if !crate::rules::force::slow(d.drag.wind[..dim].iter().copied()) {
-            return Err(Error::SpeedRange);
-        }
-        if d.drag.vortex && d.drag.rate > 0.0 && d.vortex.core_radius <= 0.0 {
-            return Err(Error::BadVortex);
-        }
-        if d.quantization == Quantization::Bits16 && !cfg!(feature = "q16") {
-            return Err(Error::Q16Disabled);
-        }
-        // A part the build left out: the step reads the description through
-        // accessors that give what the build keeps (`has_masses`,
-        // `built_forces`, `assignment`, ...), so a description they would
-        // change asks for something missing. One map of features to parts.
-        let kept = d.has_masses() == d.per_particle_mass
-            && d.has_obstacles() == d.obstacles
-            && d.built_forces() == d.forces
-            && d.has_drag() == (d.drag.rate > 0.0)
-            && (cfg!(feature = "fields") || !d.drag.field)
-            && d.assignment() == d.method
-            && d.collision_rule() == d.collisions
-            && d.has_contacts() == d.contacts
-            && d.has_energy_neutral() == d.energy_neutral;
-        if !kept {
-            return Err(Error::FeatureDisabled);
-        }
-        if d.per_particle_mass && !(1..=256).contains(&d.mass_classes) {
-            return Err(Error::CapacityRange);
+            n[k] = usize::try_from(d.size[k]).map_err(|_| Error::TooLarge)?;
         }
 
         // Cell indices are stored as u32 (surface table), so the cell count
@@ -289,6 +230,15 @@ impl Layout {
             }
         }
         Ok(Layout { n, cells, row_words, summary_words, plane, total: at })
+    }
+}
+
+impl Description {
+    /// Checks the whole description, its memory plan included (a world
+    /// too large for the target is refused); the first problem found is
+    /// returned.
+    pub fn validate(&self) -> Result<(), Error> {
+        Layout::of(self).map(|_| ())
     }
 }
 

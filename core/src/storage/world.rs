@@ -10,7 +10,8 @@ use core::mem::{align_of, size_of};
 
 use crate::Error;
 use crate::api::desc::Description;
-use crate::storage::layout::{test_bit, view, view_counted, view_ref, Layout, Plain, Planes, Site};
+use crate::rules::emitter::Slot;
+use crate::storage::layout::{test_bit, view, view_counted, view_counted_ref, view_ref, Layout, Plain, Planes, Site};
 
 /// Counters the step keeps. All integers (clamped energy in 2^-32 units),
 /// so they add up to the same bits in any block order (M8).
@@ -125,7 +126,7 @@ impl World {
         // SAFETY: `base` is aligned for Header (pad above) and the region
         // holds size_of::<Header>() + layout.total bytes, borrowed for 'a
         // and all 0. The fields are written in place (a Header built on the
-        // stack and copied over would be a `memcpy` of some 390 bytes);
+        // stack and copied over would be a `memcpy` of the whole header);
         // those not written (the step, the counters and the table counts)
         // are integers, for which the zero bytes are the value 0. The fat
         // pointer's metadata is the length of the trailing [u8].
@@ -276,6 +277,11 @@ impl World {
     /// Whether cell `s` is an obstacle: never in a build without obstacles.
     pub(crate) fn is_obstacle(&self, s: Site) -> bool {
         cfg!(feature = "obstacles") && test_bit(self.plane(self.layout().obstacle()), s.bit)
+    }
+
+    /// The emitter table, as long as its capacity.
+    pub(crate) fn slots(&self) -> &[Slot] {
+        view_counted_ref(self.plane_bytes(self.layout().emitters()), self.head.desc.emitter_capacity as usize)
     }
 }
 

@@ -1,0 +1,37 @@
+//! Adding emitters to a world and changing their rates (M6).
+
+use crate::Error;
+use crate::api::checks::finite;
+use crate::rules::emitter::{checked, Emitter, Slot};
+use crate::storage::world::World;
+
+impl World {
+    /// Adds an emitter and returns its index.
+    pub fn add_emitter(&mut self, mut e: Emitter) -> Result<usize, Error> {
+        checked(&mut e, self.dim(), self.layout().n, self.head.desc.lifetimes)?;
+        let used = self.head.emitters as usize;
+        // The capacity the plane was sized for (`Layout::of`), without a
+        // division by the slot's size.
+        if used >= self.head.desc.emitter_capacity as usize {
+            return Err(Error::EmitterTableFull);
+        }
+        let mass_index = u32::from(self.mass_index_of(e.mass)?);
+        let (head, p) = self.planes::<u8>();
+        p.emitters[used] = Slot { emitter: e, mass_index };
+        head.emitters += 1;
+        Ok(used)
+    }
+
+    /// Changes the rate of emitter `index`.
+    pub fn set_emitter_rate(&mut self, index: usize, rate: f32) -> Result<(), Error> {
+        finite(&[rate])?;
+        if rate < 0.0 {
+            return Err(Error::BadEmitter);
+        }
+        if index >= self.head.emitters as usize {
+            return Err(Error::OutOfBounds);
+        }
+        self.planes::<u8>().1.emitters[index].emitter.rate = rate;
+        Ok(())
+    }
+}

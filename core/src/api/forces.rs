@@ -1,0 +1,130 @@
+//! Setting a world's forces (M5.1) and its wind plane (M5.1b): the
+//! uniform acceleration, the vortex, the force field, the potential and
+//! the flow that drag relaxes towards, each checked before anything is
+//! written.
+
+use crate::Error;
+use crate::api::checks::{finite, slow};
+use crate::api::desc::{Boundary, Vortex};
+use crate::storage::layout::Planes;
+use crate::storage::world::World;
+
+impl World {
+    fn force_plane_check(&self, enabled: bool, values: &[f32], per_cell: usize) -> Result<(), Error> {
+        if !enabled {
+            return Err(Error::NotEnabled);
+        }
+        if values.len() != self.layout().cells * per_cell {
+            return Err(Error::BadLength);
+        }
+        finite(values)
+    }
+
+    /// Sets the uniform acceleration (M5.1). Needs `forces.uniform`.
+    pub fn set_gravity(&mut self, g: [f32; 3]) -> Result<(), Error> {
+        if !self.head.desc.forces.uniform {
+            return Err(Error::NotEnabled);
+        }
+        finite(&g)?;
+        self.head.desc.gravity = g;
+        if self.dim() == 2 {
+            self.head.desc.gravity[2] = 0.0;
+        }
+        Ok(())
+    }
+
+    /// Sets the Rankine vortex. Needs `forces.vortex`.
+    pub fn set_vortex(&mut self, v: Vortex) -> Result<(), Error> {
+        if !self.head.desc.forces.vortex {
+            return Err(Error::NotEnabled);
+        }
+        finite(&[v.centre[0], v.centre[1], v.core_radius, v.circulation])?;
+        if v.core_radius <= 0.0 {
+            return Err(Error::BadVortex);
+        }
+        self.head.desc.vortex = v;
+        Ok(())
+    }
+
+    /// Replaces the per-cell force field: `dim` components per cell, cells in
+    /// dense order (x fastest). Needs `forces.field`.
+    pub fn set_force_field(&mut self, forces: &[f32]) -> Result<(), Error> {
+        self.force_plane_check(self.head.desc.forces.field, forces, self.dim())?;
+        self.planes::<u8>().1.field.copy_from_slice(forces);
+        Ok(())
+    }
+
+    /// Sets the force on one cell. Needs `forces.field`.
+    pub fn set_cell_force(&mut self, pos: [u32; 3], f: [f32; 3]) -> Result<(), Error> {
+        self.set_cell_vector(pos, self.head.desc.forces.field, f, false, |p| p.field)
+    }
+
+    /// Writes the first `dim` components of `v` at the cell `pos` of a
+    /// plane of `dim` floats a cell, which `plane` picks, after the checks
+    /// such a setter makes: a cell of the world, a plane the world has
+    /// (`enabled`), finite values and, for a velocity, a speed of at most 1.
+    fn set_cell_vector(
+        &mut self,
+        pos: [u32; 3],
+        enabled: bool,
+        v: [f32; 3],
+        velocity: bool,
+        plane: fn(Planes<'_, u8>) -> &mut [f32],
+    ) -> Result<(), Error> {
+        let s = self.locate(pos)?;
+        if !enabled {
+            return Err(Error::NotEnabled);
+        }
+        finite(&v)?;
+        let d = self.dim();
+        if velocity && !slow(v[..d].iter().copied()) {
+            return Err(Error::SpeedRange);
+        }
+        plane(self.planes::<u8>().1)[s.cell * d..s.cell * d + d].copy_from_slice(&v[..d]);
+        Ok(())
+    }
+
+    /// Replaces the potential: one value per cell, dense order. Needs
+    /// `forces.potential`.
+    pub fn set_potential(&mut self, u: &[f32]) -> Result<(), Error> {
+        self.force_plane_check(self.head.desc.forces.potential, u, 1)?;
+        self.planes::<u8>().1.potential.copy_from_slice(u);
+        Ok(())
+    }
+
+    /// Sets the potential of one cell. Needs `forces.potential`.
+    pub fn set_cell_potential(&mut self, pos: [u32; 3], u: f32) -> Result<(), Error> {
+        let s = self.locate(pos)?;
+        if !self.head.desc.forces.potential {
+            return Err(Error::NotEnabled);
+        }
+        finite(&[u])?;
+        self.planes::<u8>().1.potential[s.cell] = u;
+        Ok(())
+    }
+
+    /// Replaces the wind plane of M5.1b: `dim` flow velocity components per
+    /// cell, cells in dense order (x fastest). Each cell's `|u|` must be at
+    /// most 1 (`SpeedRange`); the sum with the uniform wind and the vortex
+    /// is not bounded, the clamp (M5.5) is. Needs `drag.field`.
+    pub fn set_wind_field(&mut self, wind: &[f32]) -> Result<(), Error> {
+        let d = self.dim();
+        self.force_plane_check(self.head.desc.drag.field, wind, d)?;
+        if wind.chunks_exact(d).any(|u| !slow(u.iter().copied())) {
+            return Err(Error::SpeedRange);
+        }
+        self.planes::<u8>().1.wind.copy_from_slice(wind);
+        Ok(())
+    }
+
+    /// Sets the flow velocity of one cell in the wind plane, `|u| <= 1`.
+    /// Needs `drag.field`.
+    pub fn set_cell_wind(&mut self, pos: [u32; 3], u: [f32; 3]) -> Result<(), Error> {
+        self.set_cell_vector(pos, self.head.desc.drag.field, u, true, |p| p.wind)
+    }
+
+    pub(crate) fn periodic(&self) -> [bool; 3] {
+        let b = self.head.desc.boundary;
+        [0, 1, 2].map(|k| b[k][0] == Boundary::Periodic)
+    }
+}
