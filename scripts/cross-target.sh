@@ -3,7 +3,7 @@
 # Runs the scene_hashes program natively, on 32-bit Arm
 # (armv7-unknown-linux-gnueabihf) and on 64-bit Arm
 # (aarch64-unknown-linux-gnu) under QEMU user mode, and compares; on
-# 64-bit Arm also the unit test of the Neon code of M5.6 (assign/hungarian.rs,
+# 64-bit Arm also the unit test of the Neon code of M5.6 (core/src/rules/assign/hungarian.rs,
 # sign_mask). Then the same comparison for a C program linked with
 # libmpca.a and libmpca.so on 32-bit Arm.
 # Installs the cross linkers and QEMU with apt-get when they are missing.

@@ -40,13 +40,12 @@
 #[cfg(feature = "std")]
 extern crate std;
 
-pub mod assign;
 mod api;
 mod rules;
 mod step;
 mod storage;
 
-pub use rules::rng;
+pub use rules::{assign, rng};
 pub use assign::Method;
 pub use api::desc::{Boundary, Collisions, Description, Drag, Drift, Forces, Quantization, Vortex};
 pub use api::error::Error;

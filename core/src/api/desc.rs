@@ -2,7 +2,7 @@
 //! memory is touched, and the memory layout that follows from it.
 
 use crate::Error;
-use crate::assign::Method;
+use crate::rules::assign::Method;
 use crate::api::checks::{finite, mass, restitution, slow};
 
 /// What happens at one face of the domain (M4).

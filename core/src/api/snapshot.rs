@@ -42,7 +42,7 @@ use core::mem::size_of;
 use crate::Error;
 use crate::api::desc::{Boundary, Collisions, Description, Drag, Drift, Forces, Quantization, Vortex};
 use crate::api::edit::storable;
-use crate::assign::Method;
+use crate::rules::assign::Method;
 use crate::rules::emitter::{checked, Emitter, Slot};
 use crate::rules::obstacle::Surface;
 use crate::rules::quant::{with_quant, Quant};

@@ -1,6 +1,7 @@
 //! The model's rules, each in a file named after it: what happens to the
 //! particles of a block, independent of where a world keeps them.
 
+pub mod assign;
 pub(crate) mod collision;
 pub(crate) mod emitter;
 pub(crate) mod faces;

@@ -40,7 +40,7 @@
 //! M5.1 draws nothing.
 
 use crate::api::desc::{Boundary, Collisions, Description};
-use crate::assign::{assign_moves, bits, optimal_moves_2d, pick_move, Bits, Method, MoveProblem, PLACE_2D};
+use crate::rules::assign::{assign_moves, bits, optimal_moves_2d, pick_move, Bits, Method, MoveProblem, PLACE_2D};
 use crate::rules::collision::{collide_limited, collide_pair, energy_neutral, pick_pair, random_unit, shares};
 use crate::rules::force::{Flow, ForceTerms};
 use crate::rules::obstacle::{reflect, surface_at, Surface};
@@ -1303,7 +1303,7 @@ impl<'a, Q: Quant, const D: usize, const CELLS: usize> BlockSink<'a> for Kernel<
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::assign::digit;
+    use crate::rules::assign::digit;
     use crate::rules::rng::block_stream;
     use crate::{Description, World};
 

@@ -47,8 +47,8 @@ pub(super) fn greedy(problem: &MoveProblem, free: u8, count: usize, rng: &mut St
 
 #[cfg(test)]
 mod tests {
-    use crate::assign::tests::block;
-    use crate::assign::{assign_moves, Method};
+    use crate::rules::assign::tests::block;
+    use crate::rules::assign::{assign_moves, Method};
     use crate::rules::rng::block_stream;
 
     #[test]

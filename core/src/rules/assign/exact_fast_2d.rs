@@ -314,7 +314,7 @@ mod tests {
     use std::vec::Vec;
 
     use super::*;
-    use crate::assign::tests::optimal_set;
+    use crate::rules::assign::tests::optimal_set;
     use crate::rules::rng::block_stream;
 
     #[test]

@@ -372,8 +372,8 @@ mod tests {
     use std::vec::Vec;
 
     use super::*;
-    use crate::assign::tests::{block, check_uniform, optimal_set, random_block_3d, valid};
-    use crate::assign::{assign_moves, cost, Method};
+    use crate::rules::assign::tests::{block, check_uniform, optimal_set, random_block_3d, valid};
+    use crate::rules::assign::{assign_moves, cost, Method};
     use crate::rules::rng::block_stream;
 
     /// What exact-fast gives `problem` (3D) for every rank its draw could
