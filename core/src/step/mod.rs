@@ -9,16 +9,22 @@
 //! blocks through the lean routines, which have no code for them.
 
 
+pub(crate) mod block;
+pub(crate) mod clamp;
+pub(crate) mod contacts;
 pub(crate) mod emit;
 pub(crate) mod kernel;
+pub(crate) mod lanes;
 pub(crate) mod partition;
+pub(crate) mod reflection;
 #[cfg(target_has_atomic = "8")]
 pub(crate) mod tasks;
 
 use crate::rules::force::{Flow, ForceTerms};
 use crate::rules::quant::Quant;
 use crate::rules::rng::StepKey;
-use crate::step::kernel::{Kernel, Shared, Writable};
+use crate::step::block::{Shared, Writable};
+use crate::step::kernel::Kernel;
 use crate::step::partition::Partition;
 use crate::storage::cells::Cells;
 use crate::storage::layout::Layout;
