@@ -180,17 +180,15 @@ impl<T> Drop for Held<'_, T> {
 #[cfg(not(any(test, feature = "catch-panics")))]
 pub(crate) fn die(info: &core::panic::PanicInfo<'_>) -> ! {
     /// The line, built in place: one `write`, so that lines of threads
-    /// that panic together do not interleave.
-    struct Line {
-        bytes: [u8; 256],
-        len: usize,
-    }
+    /// that panic together do not interleave. What does not fit is cut,
+    /// keeping room for the newline.
+    struct Line(heapless::Vec<u8, 256>);
     impl core::fmt::Write for Line {
         fn write_str(&mut self, s: &str) -> core::fmt::Result {
-            let room = self.bytes.len() - 1 - self.len;
+            let room = self.0.capacity() - 1 - self.0.len();
             let take = s.len().min(room);
-            self.bytes[self.len..self.len + take].copy_from_slice(&s.as_bytes()[..take]);
-            self.len += take;
+            // Fits: take is at most the room left.
+            let _ = self.0.extend_from_slice(&s.as_bytes()[..take]);
             Ok(())
         }
     }
@@ -201,16 +199,17 @@ pub(crate) fn die(info: &core::panic::PanicInfo<'_>) -> ! {
         // SAFETY: abort takes nothing and does not return.
         unsafe { abort() }
     }
-    let mut line = Line { bytes: [0; 256], len: 0 };
+    let mut line = Line(heapless::Vec::new());
     let _ = match info.location() {
         Some(at) => core::fmt::write(&mut line, format_args!("mpca: panicked at {at}: {}", info.message())),
         None => core::fmt::write(&mut line, format_args!("mpca: panicked: {}", info.message())),
     };
-    line.bytes[line.len] = b'\n';
+    // The room write_str kept.
+    let _ = line.0.push(b'\n');
     #[cfg(unix)]
-    // SAFETY: the first len + 1 bytes of `line.bytes` are initialised.
+    // SAFETY: the vector's bytes are initialised, len() of them.
     unsafe {
-        write(2, line.bytes.as_ptr().cast(), line.len + 1);
+        write(2, line.0.as_ptr().cast(), line.0.len());
     }
     // SAFETY: abort takes nothing and does not return.
     unsafe { abort() }
