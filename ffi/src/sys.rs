@@ -14,7 +14,7 @@
 //! instead (lib.rs).
 
 use core::cell::UnsafeCell;
-use core::ffi::{c_int, c_void};
+use core::ffi::c_void;
 use core::ops::{Deref, DerefMut};
 use core::sync::atomic::{AtomicBool, Ordering};
 
@@ -27,13 +27,13 @@ unsafe extern "C" {
     fn calloc(count: usize, size: usize) -> *mut c_void;
     fn free(p: *mut c_void);
     #[cfg(unix)]
-    fn posix_memalign(out: *mut *mut c_void, align: usize, size: usize) -> c_int;
+    fn posix_memalign(out: *mut *mut c_void, align: usize, size: usize) -> core::ffi::c_int;
     #[cfg(all(unix, not(any(test, feature = "catch-panics"))))]
-    fn write(fd: c_int, buf: *const c_void, count: usize) -> isize;
+    fn write(fd: core::ffi::c_int, buf: *const c_void, count: usize) -> isize;
     #[cfg(not(any(test, feature = "catch-panics")))]
     fn abort() -> !;
     #[cfg(unix)]
-    fn sched_yield() -> c_int;
+    fn sched_yield() -> core::ffi::c_int;
 }
 
 /// Rust's global allocator in hosted builds: the C library's `malloc`
@@ -222,8 +222,15 @@ pub(crate) fn die(info: &core::panic::PanicInfo<'_>) -> ! {
 /// `rust_eh_personality` (rust-lang/rust#106864). Never called: nothing in
 /// this library unwinds (panic = "abort"); were it called, it answers
 /// `_URC_FAILURE`, so an unwinder stops instead of passing through.
-#[cfg(not(any(test, feature = "catch-panics")))]
+#[cfg(not(any(test, feature = "catch-panics", all(windows, target_arch = "x86_64"))))]
 #[unsafe(no_mangle)]
-extern "C" fn rust_eh_personality() -> c_int {
+extern "C" fn rust_eh_personality() -> core::ffi::c_int {
     9
 }
+
+// The same routine for mpca.dll, in assembly: rustc exports every
+// #[no_mangle] function of a DLL through the module definition file it
+// writes, which no linker option can take a name back from, while a
+// symbol rustc does not know of stays the DLL's own.
+#[cfg(all(windows, target_arch = "x86_64", not(any(test, feature = "catch-panics"))))]
+core::arch::global_asm!(".globl rust_eh_personality", "rust_eh_personality:", "mov eax, 9", "ret");
