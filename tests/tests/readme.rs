@@ -1,8 +1,8 @@
 //! What README.md shows a newcomer to copy: every ```rust block is a whole
 //! `main.rs` (its own `fn main`, no lines hidden as rustdoc's `# ` lines
 //! hide them), so it pastes and runs as it stands. The blocks themselves
-//! compile and run as doctests of the core (core/src/lib.rs includes the
-//! README for that).
+//! compile and run as doctests of this crate's library (src/lib.rs
+//! includes the README for that).
 
 use std::path::Path;
 
