@@ -222,15 +222,48 @@ pub(crate) fn die(info: &core::panic::PanicInfo<'_>) -> ! {
 /// `rust_eh_personality` (rust-lang/rust#106864). Never called: nothing in
 /// this library unwinds (panic = "abort"); were it called, it answers
 /// `_URC_FAILURE`, so an unwinder stops instead of passing through.
-#[cfg(not(any(test, feature = "catch-panics", all(windows, target_arch = "x86_64"))))]
+///
+/// Where a shared library is built (Linux, Windows), it is written in
+/// assembly below instead: rustc exports every `#[no_mangle]` function of
+/// a cdylib (through the version script or the DLL's module definition
+/// file it writes, which a second version script cannot override with GNU
+/// ld), and the library exports the header's functions alone. A symbol
+/// rustc does not know of stays the library's own, hidden on ELF.
+#[cfg(not(any(test, feature = "catch-panics", personality_in_asm)))]
 #[unsafe(no_mangle)]
 extern "C" fn rust_eh_personality() -> core::ffi::c_int {
     9
 }
 
-// The same routine for mpca.dll, in assembly: rustc exports every
-// #[no_mangle] function of a DLL through the module definition file it
-// writes, which no linker option can take a name back from, while a
-// symbol rustc does not know of stays the DLL's own.
-#[cfg(all(windows, target_arch = "x86_64", not(any(test, feature = "catch-panics"))))]
+#[cfg(all(personality_in_asm, not(test), target_os = "linux", target_arch = "x86_64"))]
+core::arch::global_asm!(
+    ".globl rust_eh_personality",
+    ".hidden rust_eh_personality",
+    ".type rust_eh_personality, %function",
+    "rust_eh_personality:",
+    "mov eax, 9",
+    "ret",
+);
+
+#[cfg(all(personality_in_asm, not(test), target_os = "linux", target_arch = "aarch64"))]
+core::arch::global_asm!(
+    ".globl rust_eh_personality",
+    ".hidden rust_eh_personality",
+    ".type rust_eh_personality, %function",
+    "rust_eh_personality:",
+    "mov w0, #9",
+    "ret",
+);
+
+#[cfg(all(personality_in_asm, not(test), target_os = "linux", target_arch = "arm"))]
+core::arch::global_asm!(
+    ".globl rust_eh_personality",
+    ".hidden rust_eh_personality",
+    ".type rust_eh_personality, %function",
+    "rust_eh_personality:",
+    "mov r0, #9",
+    "bx lr",
+);
+
+#[cfg(all(personality_in_asm, not(test), windows))]
 core::arch::global_asm!(".globl rust_eh_personality", "rust_eh_personality:", "mov eax, 9", "ret");

@@ -505,7 +505,7 @@ fn the_shared_library_needs_only_the_c_library() {
 
 /// The dynamic symbol table of libmpca.so holds the header's functions and
 /// nothing else: no Rust symbol (rust_eh_personality, say) that a program
-/// could bind to or clash with (ffi/exports.map).
+/// could bind to or clash with (ffi/src/sys.rs).
 #[test]
 fn shared_library_exports_exactly_the_header_functions() {
     let exported = Elf::read(&library().join("libmpca.so")).exported_symbols();
