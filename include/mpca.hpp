@@ -18,9 +18,13 @@
  *   (export_positions and its twins, for a mapped vertex buffer).
  * - step_parallel takes any callable host, a lambda or a std::function,
  *   which runs one step's tasks on the caller's threads (M11).
+ * - world::init and world::init_from_image build a world in the caller's
+ *   memory instead (mpca_world_init, for builds without an allocator);
+ *   the object then ends it with mpca_world_deinit and never frees it.
  *
- * Each method is one call of the C function of the same name; get() gives
- * the mpca_world * for everything else in mpca.h.
+ * Each method is one call of the C function of the same name, and every
+ * function of mpca.h has one (tests/c/cpp_wrapper.cpp takes the address of
+ * each); get() gives the mpca_world * all the same.
  */
 #ifndef MPCA_HPP
 #define MPCA_HPP
@@ -79,6 +83,29 @@ inline mpca_desc desc_3d(std::uint32_t nx, std::uint32_t ny, std::uint32_t nz) {
     check(mpca_desc_defaults(&d, 3, nx, ny, nz));
     return d;
 }
+
+/** Checks a description in full, as mpca_world_create will (mpca_desc_validate). */
+inline void validate(const mpca_desc &desc) { check(mpca_desc_validate(&desc)); }
+
+/** The bytes of caller memory a world of `desc` needs (mpca_world_bytes). */
+inline std::size_t world_bytes(const mpca_desc &desc) {
+    std::size_t bytes = 0;
+    check(mpca_world_bytes(&desc, &bytes));
+    return bytes;
+}
+
+/** The description of the world a snapshot image holds (mpca_desc_from_image). */
+inline mpca_desc desc_from_image(const void *image, std::size_t len) {
+    mpca_desc d = mpca_desc();
+    check(mpca_desc_from_image(image, len, &d));
+    return d;
+}
+
+/** An obstacle surface cell: its outward normal and restitution. */
+struct surface {
+    vec3 normal;
+    float restitution;
+};
 
 /**
  * The tasks of one step of world::step_parallel, as the host receives
@@ -140,16 +167,40 @@ extern "C" inline void mpca_hpp_run_tasks(mpca_world *world, std::uint64_t ticke
 class world {
 public:
     /** mpca_world_create; throws mpca::error if `desc` is refused. */
-    explicit world(const mpca_desc &desc) : w_(nullptr) { check(mpca_world_create(&desc, &w_)); }
+    explicit world(const mpca_desc &desc) : w_(nullptr), in_caller_memory_(false) {
+        check(mpca_world_create(&desc, &w_));
+    }
+
+    /**
+     * An empty world built in `memory` (`len` bytes, at least
+     * world_bytes(desc), any alignment) by mpca_world_init. The memory
+     * stays the caller's: keep it, unmoved, while the object holds the
+     * world, which ends it with mpca_world_deinit.
+     */
+    static world init(const mpca_desc &desc, void *memory, std::size_t len) {
+        mpca_world *w = nullptr;
+        check(mpca_world_init(&desc, memory, len, &w));
+        return world(w);
+    }
+
+    /** The world a snapshot image holds, built in `memory` as init() builds
+     * one (mpca_world_init_from_image; size it with
+     * world_bytes(desc_from_image(image, image_len))). */
+    static world init_from_image(const void *image, std::size_t image_len, void *memory, std::size_t len) {
+        mpca_world *w = nullptr;
+        check(mpca_world_init_from_image(image, image_len, memory, len, &w));
+        return world(w);
+    }
 
     ~world() { reset(); }
 
-    world(world &&other) noexcept : w_(other.w_) { other.w_ = nullptr; }
+    world(world &&other) noexcept : w_(other.w_), in_caller_memory_(other.in_caller_memory_) { other.w_ = nullptr; }
 
     world &operator=(world &&other) noexcept {
         if (this != &other) {
             reset();
             w_ = other.w_;
+            in_caller_memory_ = other.in_caller_memory_;
             other.w_ = nullptr;
         }
         return *this;
@@ -165,10 +216,15 @@ public:
     /** Whether this object holds a world (it does until moved from or reset). */
     explicit operator bool() const noexcept { return w_ != nullptr; }
 
-    /** Destroys the world now; the object is empty afterwards. */
+    /** Ends the world now (mpca_world_destroy, or mpca_world_deinit for
+     * one in caller memory); the object is empty afterwards. */
     void reset() noexcept {
         if (w_ != nullptr) {
-            mpca_world_destroy(w_);
+            if (in_caller_memory_) {
+                mpca_world_deinit(w_);
+            } else {
+                mpca_world_destroy(w_);
+            }
             w_ = nullptr;
         }
     }
@@ -307,6 +363,47 @@ public:
         return out;
     }
 
+    /** The particles, momentum and kinetic energy in the box of cells
+     * min <= c < max (mpca_world_region_stats). */
+    mpca_region_stats region_stats(const cell_pos &min, const cell_pos &max) const {
+        mpca_region_stats r = mpca_region_stats();
+        r.struct_size = sizeof r;
+        check(mpca_world_region_stats(w_, min.data(), max.data(), &r));
+        return r;
+    }
+
+    // --- snapshots (M12) --------------------------------------------------------
+
+    /** The length of the image save() would write now (mpca_world_snapshot_bytes). */
+    std::size_t snapshot_bytes() const {
+        std::size_t n = 0;
+        check(mpca_world_snapshot_bytes(w_, &n));
+        return n;
+    }
+
+    /** The world's image (mpca_world_save). */
+    std::vector<std::uint8_t> save() const {
+        std::vector<std::uint8_t> image(snapshot_bytes());
+        image.resize(save(image.data(), image.size()));
+        return image;
+    }
+
+    /** The world's image into the caller's buffer of `len` bytes; returns
+     * its length (mpca_world_save; too small a buffer throws
+     * MPCA_STATUS_OUTPUT_TOO_SMALL). */
+    std::size_t save(void *buf, std::size_t len) const {
+        std::size_t written = 0;
+        check(mpca_world_save(w_, buf, len, &written));
+        return written;
+    }
+
+    /** Replaces this world's state with an image of a world of the same
+     * plan (mpca_world_load); a refused image changes nothing. */
+    void load(const void *image, std::size_t len) { check(mpca_world_load(w_, image, len)); }
+
+    /** As load(image, len), from a vector save() returned. */
+    void load(const std::vector<std::uint8_t> &image) { load(image.data(), image.size()); }
+
     // --- forces, obstacles, emitters ------------------------------------------
 
     /** The uniform acceleration (mpca_world_set_gravity). */
@@ -321,6 +418,47 @@ public:
 
     /** The flow velocity of one cell in the wind plane (mpca_world_set_cell_wind). */
     void set_cell_wind(const cell_pos &pos, const vec3 &u) { check(mpca_world_set_cell_wind(w_, pos.data(), u.data())); }
+
+    /** Replaces the force field: dim components per cell, x fastest
+     * (mpca_world_set_force_field). */
+    void set_force_field(const std::vector<float> &forces) {
+        check(mpca_world_set_force_field(w_, forces.data(), forces.size()));
+    }
+
+    /** The force of one cell (mpca_world_set_cell_force). */
+    void set_cell_force(const cell_pos &pos, const vec3 &force) {
+        check(mpca_world_set_cell_force(w_, pos.data(), force.data()));
+    }
+
+    /** Replaces the potential, one value per cell, x fastest (mpca_world_set_potential). */
+    void set_potential(const std::vector<float> &u) { check(mpca_world_set_potential(w_, u.data(), u.size())); }
+
+    /** The potential of one cell (mpca_world_set_cell_potential). */
+    void set_cell_potential(const cell_pos &pos, float u) { check(mpca_world_set_cell_potential(w_, pos.data(), u)); }
+
+    /** Moves or changes the Rankine vortex (mpca_world_set_vortex). */
+    void set_vortex(float cx, float cy, float core_radius, float circulation) {
+        check(mpca_world_set_vortex(w_, cx, cy, core_radius, circulation));
+    }
+
+    /** One obstacle cell with the given outward normal (mpca_world_add_obstacle). */
+    void add_obstacle(const cell_pos &pos, const vec3 &normal, float e) {
+        check(mpca_world_add_obstacle(w_, pos.data(), normal.data(), e));
+    }
+
+    /** Obstacle cells where `mask`, one byte a cell, x fastest, is not 0
+     * (mpca_world_add_obstacle_mask). */
+    void add_obstacle_mask(const std::vector<std::uint8_t> &mask, float e) {
+        check(mpca_world_add_obstacle_mask(w_, mask.data(), mask.size(), e));
+    }
+
+    /** The normal and restitution of the obstacle surface cell at `pos`
+     * (mpca_world_surface; MPCA_STATUS_NOT_A_SURFACE if it is none). */
+    mpca::surface surface(const cell_pos &pos) const {
+        mpca::surface s = mpca::surface();
+        check(mpca_world_surface(w_, pos.data(), s.normal.data(), &s.restitution));
+        return s;
+    }
 
     /** Obstacle cells with centres in the box min <= c <= max. */
     void add_box(const vec3 &min, const vec3 &max, float e) {
@@ -384,7 +522,11 @@ private:
         return n;
     }
 
+    /** A world mpca_world_init built: deinitialised, never destroyed. */
+    explicit world(mpca_world *w) noexcept : w_(w), in_caller_memory_(true) {}
+
     mpca_world *w_;
+    bool in_caller_memory_;
 };
 
 } // namespace mpca

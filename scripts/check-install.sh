@@ -10,6 +10,12 @@
 #   CMake          find_package(mpca CONFIG REQUIRED): mpca::mpca (C and
 #                  C++ through mpca.hpp) and mpca::mpca_static
 #   plain cc       -I$prefix/include -L$prefix/lib -lmpca, with an rpath
+#   README.md      every line of its blocks marked <!-- link-lines: ... -->,
+#                  as shown (PREFIX the temporary prefix), with the consumer
+#                  as app.c and app.cpp, and every app they build run
+#
+# It also checks that the installed libmpca.so is stripped, with its
+# symbols and debug information in the file its .gnu_debuglink names.
 #
 # Every build must print the same line: the installed version, the
 # particles and the world's hash. Installs cmake and pkg-config with
@@ -53,6 +59,12 @@ soname=$(readelf -d "$prefix/lib/libmpca.so.$version" | sed -n 's/.*(SONAME).*\[
 [ "$soname" = "libmpca.so.$major" ] || fail "SONAME is '$soname', not libmpca.so.$major"
 echo "mpca $version: SONAME $soname; libmpca.so -> libmpca.so.$major -> libmpca.so.$version"
 readelf -d "$prefix/lib/libmpca.so.$version" | grep -E '\((NEEDED|SONAME)\)'
+sections() { readelf -S -W "$1" | sed -n 's/^ *\[ *[0-9]*\] \([^ ]*\) .*/\1/p'; }
+! sections "$prefix/lib/libmpca.so.$version" | grep -qE '^\.(symtab|debug_)' || fail "the installed libmpca.so is not stripped"
+sections "$prefix/lib/libmpca.so.$version.debug" | grep -qx .symtab || fail "libmpca.so.$version.debug holds no symbols"
+link=$(readelf -p .gnu_debuglink "$prefix/lib/libmpca.so.$version" | sed -n 's/^ *\[ *0\] *//p')
+[ "$link" = "libmpca.so.$version.debug" ] || fail "the .gnu_debuglink of libmpca.so names '$link'"
+echo "stripped: $(stat -c %s "$prefix/lib/libmpca.so.$version") bytes; symbols and debug information: libmpca.so.$version.debug, $(stat -c %s "$prefix/lib/libmpca.so.$version.debug") bytes"
 
 # needed EXE: its DT_NEEDED libraries, one a line.
 needed() { readelf -d "$1" | sed -n 's/.*(NEEDED).*\[\(.*\)\]/\1/p'; }
@@ -106,6 +118,47 @@ needed "$tmp/build/consumer_shared" | grep -qx "libmpca.so.$major" || fail "mpca
 run cmake-shared "$tmp/build/consumer_shared"
 run cmake-static "$tmp/build/consumer_static"
 run cmake-cpp "$tmp/build/consumer_cpp"
+
+# readme_block MARKER: the lines of the ```sh block after <!-- link-lines: MARKER -->.
+readme_block() {
+    awk -v m="<!-- link-lines: $1 -->" '$0 == m {on = 1; next} on && /^```sh/ {inside = 1; next} inside && /^```/ {exit} inside {print}' "$root/README.md"
+}
+# run_readme_block MARKER DIR: runs the block's lines in DIR as shown, PREFIX
+# replaced, in one shell (an export holds for the lines after it); after
+# each line that builds app, app runs without LD_LIBRARY_PATH.
+run_readme_block() {
+    local marker=$1 dir=$2 script="$tmp/readme-$1.sh" n=0
+    [ -n "$(readme_block "$marker")" ] || fail "README.md has no block after <!-- link-lines: $marker -->"
+    echo "set -euo pipefail" > "$script"
+    while IFS= read -r line; do
+        line=${line//PREFIX/$prefix}
+        printf 'echo %q\n%s\n' "\$ $line" "$line" >> "$script"
+        case "$line" in *" -o app"*) n=$((n + 1)); echo "env -u LD_LIBRARY_PATH ./app > \"$tmp/readme-$marker-$n.out\"" >> "$script" ;; esac
+    done < <(readme_block "$marker")
+    (cd "$dir" && env -u LD_LIBRARY_PATH bash "$script") || fail "a line of README.md's '$marker' block failed"
+    for i in $(seq 1 "$n"); do
+        line=$(cat "$tmp/readme-$marker-$i.out")
+        echo "README $marker, build $i: $line"
+        case "$line" in "$expected"*) ;; *) fail "README $marker build $i printed '$line', not '$expected...'" ;; esac
+        outputs+=("$line")
+    done
+}
+
+echo "== README.md's link lines, as shown"
+mkdir -p "$tmp/readme"
+cp "$tmp/src/consumer.c" "$tmp/readme/app.c"
+cp "$tmp/src/consumer.cpp" "$tmp/readme/app.cpp"
+run_readme_block installed "$tmp/readme"
+unset PKG_CONFIG_PATH
+# The build folder's lines run from the repository's root: a folder of
+# links to its entries (the build folder's included), so app lands apart.
+mkdir -p "$tmp/tree"
+for entry in "$root"/*; do ln -s "$entry" "$tmp/tree/"; done
+build_dir=${CARGO_TARGET_DIR:-$root/target}
+case "$build_dir" in /*) ;; *) build_dir="$root/$build_dir" ;; esac
+ln -sfn "$build_dir" "$tmp/tree/target"
+cp "$tmp/src/consumer.c" "$tmp/tree/app.c"
+run_readme_block "build folder" "$tmp/tree"
 
 for line in "${outputs[@]}"; do
     [ "$line" = "${outputs[0]}" ] || fail "the builds disagree: '$line' against '${outputs[0]}'"

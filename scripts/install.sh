@@ -6,7 +6,11 @@
 #
 #   DIR/include/mpca.h, mpca.hpp               the C header, the C++ wrapper
 #   DIR/lib/libmpca.a                          static library
-#   DIR/lib/libmpca.so.X.Y.Z                   shared library, SONAME libmpca.so.X
+#   DIR/lib/libmpca.so.X.Y.Z                   shared library, SONAME libmpca.so.X,
+#                                                stripped
+#   DIR/lib/libmpca.so.X.Y.Z.debug             its symbols and debug information,
+#                                                found by gdb through the library's
+#                                                .gnu_debuglink
 #   DIR/lib/libmpca.so.X -> libmpca.so.X.Y.Z   what programs load
 #   DIR/lib/libmpca.so -> libmpca.so.X         what -lmpca finds
 #   DIR/lib/pkgconfig/mpca.pc                  pkg-config --cflags --libs mpca
@@ -23,7 +27,7 @@
 # (--print native-static-libs), read while building.
 set -euo pipefail
 
-usage() { sed -n '2,23p' "$0" | sed 's/^# \{0,1\}//'; }
+usage() { sed -n '2,27p' "$0" | sed 's/^# \{0,1\}//'; }
 prefix=
 while [ $# -gt 0 ]; do
     case "$1" in
@@ -64,7 +68,14 @@ echo "== installing mpca $version under ${DESTDIR:+$DESTDIR}$prefix"
 install -d "$dest/include" "$dest/lib/pkgconfig" "$dest/lib/cmake/mpca"
 install -m 644 include/mpca.h include/mpca.hpp "$dest/include/"
 install -m 644 "$built/libmpca.a" "$dest/lib/libmpca.a"
-install -m 755 "$built/libmpca.so" "$dest/lib/$real"
+# Stripped, as distributions ship libraries: the symbols and line tables
+# (the release profile's debug = "line-tables-only") go to a file apart,
+# which the stripped library names in its .gnu_debuglink.
+objcopy --only-keep-debug "$built/libmpca.so" "$dest/lib/$real.debug"
+chmod 644 "$dest/lib/$real.debug"
+strip -o "$dest/lib/$real" "$built/libmpca.so"
+(cd "$dest/lib" && objcopy --add-gnu-debuglink="$real.debug" "$real")
+chmod 755 "$dest/lib/$real"
 ln -sfn "$real" "$dest/lib/libmpca.so.$major"
 ln -sfn "libmpca.so.$major" "$dest/lib/libmpca.so"
 
@@ -134,7 +145,7 @@ endif()
 EOF
 
 echo "installed:"
-for f in include/mpca.h include/mpca.hpp lib/libmpca.a lib/$real lib/libmpca.so.$major lib/libmpca.so \
+for f in include/mpca.h include/mpca.hpp lib/libmpca.a lib/$real lib/$real.debug lib/libmpca.so.$major lib/libmpca.so \
     lib/pkgconfig/mpca.pc lib/cmake/mpca/mpcaConfig.cmake lib/cmake/mpca/mpcaConfigVersion.cmake; do
     if [ -L "$dest/$f" ]; then echo "  $prefix/$f -> $(readlink "$dest/$f")"; else echo "  $prefix/$f"; fi
 done

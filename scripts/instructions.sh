@@ -25,6 +25,10 @@
 #                                           the same classes of up to 5 free cells block
 #                                           by block (400 each): how many blocks cost
 #                                           exact-fast more than exhaustive, by how much
+#   scripts/instructions.sh --streams       M8: instructions per block to start a block's
+#                                           stream and draw two outputs, the step's
+#                                           counter-based stream against a PCG32 seeded
+#                                           per block (tests/src/bin/stream_seeding.rs)
 #
 # Installs valgrind with apt-get when it is missing.
 set -euo pipefail
@@ -42,6 +46,18 @@ solve_counted() {
     valgrind --tool=callgrind --callgrind-out-file="$out/cg" --collect-atstart=no \
         --toggle-collect='*assign_blocks*solve*' ${dump:+"$dump"} target/release/assign_blocks 3 "$@"
 }
+
+if [ "${1:-}" = "--streams" ]; then
+    blocks=100000
+    cargo build --release -q -p mpca-tests --bin stream_seeding
+    printf '%-8s %16s\n' stream "instr/block"
+    for which in counter pcg; do
+        valgrind --tool=callgrind --callgrind-out-file="$out/$which.cg" --collect-atstart=no \
+            --toggle-collect="*stream_seeding*${which}_streams*" target/release/stream_seeding "$which" $blocks >/dev/null 2>&1
+        awk -v w="$which" -v n=$blocks '/^(summary|totals):/{printf "%-8s %16.1f\n", w, $2 / n; exit}' "$out/$which.cg"
+    done
+    exit 0
+fi
 
 if [ "${1:-}" = "--classes" ]; then
     blocks=4000

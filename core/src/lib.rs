@@ -1,35 +1,7 @@
-//! # mpca: particles on a Margolus-neighbourhood cellular automaton
-//!
-//! A `no_std` implementation of the particle model of Ecchu, Takai and Sato,
-//! "Particle Motion Modeling by Cellular Automata and its Applications"
-//! (1993), for 2D and 3D from one code path. The rules are numbered as in
-//! `docs/model.md` (M1-M12) and cited where they are implemented.
-//!
-//! A world lives in memory the caller hands in; nothing is allocated.
-//!
-//! ```
-//! use mpca::{Boundary, Description, World};
-//!
-//! // A 64 x 64 box with walls and gravity.
-//! let mut desc = Description::new_2d(64, 64).with_boundary(Boundary::Wall);
-//! desc.forces.uniform = true;
-//! desc.gravity = [0.0, -0.01, 0.0];
-//! desc.seed = 42;
-//!
-//! let mut memory = [0u8; 16 * 1024];
-//! let world = World::init(&desc, &mut memory).unwrap();
-//! for x in 0..64 {
-//!     world.add_particle([x, 60, 0], [0.0, 0.0, 0.0]).unwrap();
-//! }
-//! world.step(100);
-//! let stats = world.stats();
-//! assert_eq!(stats.particles, 64);
-//! assert!(stats.momentum[1] < 0.0); // falling
-//! ```
-//!
-//! Where this crate resolves a point the paper leaves open or goes beyond
-//! it, the item says so: boundaries (M4), the calibrated drift rule (M5.3),
-//! the exact-fast assignment (M5.6), quantized storage (M1), emitters (M6).
+// The crate's documentation is its README (core/README.md): what crates.io
+// and docs.rs show open on the same runnable example, and it runs as a
+// doctest.
+#![doc = include_str!("../README.md")]
 #![no_std]
 #![deny(missing_docs)]
 #![warn(clippy::std_instead_of_core, clippy::alloc_instead_of_core)]
@@ -68,8 +40,3 @@ pub use storage::world::{world_bytes, World, WORLD_ALIGN};
 pub(crate) const fn sized(full: usize, under_miri: usize) -> usize {
     if cfg!(miri) { under_miri } else { full }
 }
-
-/// The README's Rust example, compiled and run as a doctest so it stays true.
-#[cfg(doctest)]
-#[doc = include_str!("../../README.md")]
-struct ReadmeExample;

@@ -14,7 +14,7 @@
 //! instead (lib.rs).
 
 use core::cell::UnsafeCell;
-use core::ffi::{c_int, c_void};
+use core::ffi::c_void;
 use core::ops::{Deref, DerefMut};
 use core::sync::atomic::{AtomicBool, Ordering};
 
@@ -27,13 +27,13 @@ unsafe extern "C" {
     fn calloc(count: usize, size: usize) -> *mut c_void;
     fn free(p: *mut c_void);
     #[cfg(unix)]
-    fn posix_memalign(out: *mut *mut c_void, align: usize, size: usize) -> c_int;
+    fn posix_memalign(out: *mut *mut c_void, align: usize, size: usize) -> core::ffi::c_int;
     #[cfg(all(unix, not(any(test, feature = "catch-panics"))))]
-    fn write(fd: c_int, buf: *const c_void, count: usize) -> isize;
+    fn write(fd: core::ffi::c_int, buf: *const c_void, count: usize) -> isize;
     #[cfg(not(any(test, feature = "catch-panics")))]
     fn abort() -> !;
     #[cfg(unix)]
-    fn sched_yield() -> c_int;
+    fn sched_yield() -> core::ffi::c_int;
 }
 
 /// Rust's global allocator in hosted builds: the C library's `malloc`
@@ -180,17 +180,15 @@ impl<T> Drop for Held<'_, T> {
 #[cfg(not(any(test, feature = "catch-panics")))]
 pub(crate) fn die(info: &core::panic::PanicInfo<'_>) -> ! {
     /// The line, built in place: one `write`, so that lines of threads
-    /// that panic together do not interleave.
-    struct Line {
-        bytes: [u8; 256],
-        len: usize,
-    }
+    /// that panic together do not interleave. What does not fit is cut,
+    /// keeping room for the newline.
+    struct Line(heapless::Vec<u8, 256>);
     impl core::fmt::Write for Line {
         fn write_str(&mut self, s: &str) -> core::fmt::Result {
-            let room = self.bytes.len() - 1 - self.len;
+            let room = self.0.capacity() - 1 - self.0.len();
             let take = s.len().min(room);
-            self.bytes[self.len..self.len + take].copy_from_slice(&s.as_bytes()[..take]);
-            self.len += take;
+            // Fits: take is at most the room left.
+            let _ = self.0.extend_from_slice(&s.as_bytes()[..take]);
             Ok(())
         }
     }
@@ -201,16 +199,17 @@ pub(crate) fn die(info: &core::panic::PanicInfo<'_>) -> ! {
         // SAFETY: abort takes nothing and does not return.
         unsafe { abort() }
     }
-    let mut line = Line { bytes: [0; 256], len: 0 };
+    let mut line = Line(heapless::Vec::new());
     let _ = match info.location() {
         Some(at) => core::fmt::write(&mut line, format_args!("mpca: panicked at {at}: {}", info.message())),
         None => core::fmt::write(&mut line, format_args!("mpca: panicked: {}", info.message())),
     };
-    line.bytes[line.len] = b'\n';
+    // The room write_str kept.
+    let _ = line.0.push(b'\n');
     #[cfg(unix)]
-    // SAFETY: the first len + 1 bytes of `line.bytes` are initialised.
+    // SAFETY: the vector's bytes are initialised, len() of them.
     unsafe {
-        write(2, line.bytes.as_ptr().cast(), line.len + 1);
+        write(2, line.0.as_ptr().cast(), line.0.len());
     }
     // SAFETY: abort takes nothing and does not return.
     unsafe { abort() }
@@ -223,8 +222,48 @@ pub(crate) fn die(info: &core::panic::PanicInfo<'_>) -> ! {
 /// `rust_eh_personality` (rust-lang/rust#106864). Never called: nothing in
 /// this library unwinds (panic = "abort"); were it called, it answers
 /// `_URC_FAILURE`, so an unwinder stops instead of passing through.
-#[cfg(not(any(test, feature = "catch-panics")))]
+///
+/// Where a shared library is built (Linux, Windows), it is written in
+/// assembly below instead: rustc exports every `#[no_mangle]` function of
+/// a cdylib (through the version script or the DLL's module definition
+/// file it writes, which a second version script cannot override with GNU
+/// ld), and the library exports the header's functions alone. A symbol
+/// rustc does not know of stays the library's own, hidden on ELF.
+#[cfg(not(any(test, feature = "catch-panics", personality_in_asm)))]
 #[unsafe(no_mangle)]
-extern "C" fn rust_eh_personality() -> c_int {
+extern "C" fn rust_eh_personality() -> core::ffi::c_int {
     9
 }
+
+#[cfg(all(personality_in_asm, not(test), target_os = "linux", target_arch = "x86_64"))]
+core::arch::global_asm!(
+    ".globl rust_eh_personality",
+    ".hidden rust_eh_personality",
+    ".type rust_eh_personality, %function",
+    "rust_eh_personality:",
+    "mov eax, 9",
+    "ret",
+);
+
+#[cfg(all(personality_in_asm, not(test), target_os = "linux", target_arch = "aarch64"))]
+core::arch::global_asm!(
+    ".globl rust_eh_personality",
+    ".hidden rust_eh_personality",
+    ".type rust_eh_personality, %function",
+    "rust_eh_personality:",
+    "mov w0, #9",
+    "ret",
+);
+
+#[cfg(all(personality_in_asm, not(test), target_os = "linux", target_arch = "arm"))]
+core::arch::global_asm!(
+    ".globl rust_eh_personality",
+    ".hidden rust_eh_personality",
+    ".type rust_eh_personality, %function",
+    "rust_eh_personality:",
+    "mov r0, #9",
+    "bx lr",
+);
+
+#[cfg(all(personality_in_asm, not(test), windows))]
+core::arch::global_asm!(".globl rust_eh_personality", "rust_eh_personality:", "mov eax, 9", "ret");

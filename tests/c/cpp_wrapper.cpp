@@ -12,7 +12,12 @@
  *   hashes equal, and the exports are the same bytes;
  * - step_parallel with a lambda, a std::function on two std::threads, a
  *   host that throws (the step completes, the exception comes back, no
- *   later step runs) and misused tasks.
+ *   later step runs) and misused tasks;
+ * - the rest: worlds in caller memory, snapshots, region counters, force
+ *   fields, potentials, the vortex, single obstacle cells and masks, each
+ *   against the C call;
+ * - every function: the address of the wrapper of each function of mpca.h,
+ *   printed as "wraps: NAME" (c_abi.rs holds the names to the header's).
  *
  * Prints "sanitizer: address" or "none" first (as the C programs do),
  * "cpp: GROUP" for each group it finished and "cpp checks: N
@@ -384,6 +389,190 @@ static void parallel() {
     std::printf("cpp: parallel\n");
 }
 
+/* A walled 2D world with every force and obstacles, filled the same way
+ * through the wrapper and through mpca.h. */
+static mpca_desc forces_desc() {
+    mpca_desc d = box_desc();
+    d.forces = MPCA_FORCE_UNIFORM | MPCA_FORCE_FIELD | MPCA_FORCE_POTENTIAL | MPCA_FORCE_VORTEX;
+    d.vortex_centre[0] = d.vortex_centre[1] = 16.0f;
+    d.vortex_core_radius = 3.0f;
+    d.vortex_circulation = 0.5f;
+    d.obstacles = 1;
+    d.surface_capacity = 64;
+    return d;
+}
+
+static void the_rest() {
+    /* Caller memory: mpca_world_bytes, init, deinit on reset. */
+    const mpca_desc d = box_desc();
+    mpca::validate(d);
+    mpca_desc odd = d;
+    odd.size[0] = 31;
+    THROWS(MPCA_STATUS_SIZE_ODD, mpca::validate(odd));
+    THROWS(MPCA_STATUS_SIZE_ODD, mpca::world_bytes(odd));
+    const std::size_t bytes = mpca::world_bytes(d);
+    std::size_t c_bytes = 0;
+    CHECK(mpca_world_bytes(&d, &c_bytes) == MPCA_STATUS_OK && bytes == c_bytes);
+    std::vector<unsigned char> memory(bytes + 1);
+    THROWS(MPCA_STATUS_BUFFER_TOO_SMALL, mpca::world::init(d, memory.data(), bytes / 2));
+    mpca_world *raw = nullptr;
+    std::vector<std::uint8_t> image;
+    std::uint64_t hash = 0;
+    {
+        /* At an odd address: any alignment is accepted. */
+        mpca::world w = mpca::world::init(d, memory.data() + 1, bytes);
+        raw = w.get();
+        fill_box(w);
+        w.step(10);
+        hash = w.hash();
+        image = w.save();
+        CHECK(image.size() == w.snapshot_bytes());
+        THROWS(MPCA_STATUS_OUTPUT_TOO_SMALL, w.save(image.data(), image.size() - 1));
+        const mpca_region_stats all = w.region_stats({0, 0, 0}, {32, 32, 1});
+        CHECK(all.particles == w.particle_count());
+        THROWS(MPCA_STATUS_BAD_SHAPE, w.region_stats({4, 4, 0}, {2, 8, 1}));
+    }
+    CHECK(!alive(raw)); /* deinitialised by the destructor */
+
+    /* The image back: a world in fresh memory, and one loaded into. */
+    const mpca_desc from_image = mpca::desc_from_image(image.data(), image.size());
+    CHECK(std::memcmp(&from_image.size, &d.size, sizeof d.size) == 0);
+    THROWS(MPCA_STATUS_IMAGE_LENGTH, mpca::desc_from_image(image.data(), image.size() - 1));
+    std::vector<unsigned char> other(mpca::world_bytes(from_image));
+    mpca::world copy = mpca::world::init_from_image(image.data(), image.size(), other.data(), other.size());
+    CHECK(copy.hash() == hash);
+    mpca::world loaded(d);
+    loaded.load(image);
+    CHECK(loaded.hash() == hash);
+    copy.step(5);
+    loaded.step(5);
+    CHECK(copy.hash() == loaded.hash());
+    image[image.size() / 2] ^= 1;
+    const std::uint64_t before = loaded.hash();
+    THROWS(MPCA_STATUS_IMAGE_CHECKSUM, loaded.load(image));
+    CHECK(loaded.hash() == before);
+
+    /* Forces and obstacles: the same calls through mpca.h give the same world. */
+    const mpca_desc f = forces_desc();
+    mpca::world w(f);
+    mpca_world *c = nullptr;
+    CHECK(mpca_world_create(&f, &c) == MPCA_STATUS_OK);
+    std::vector<float> field(2 * 32 * 32), potential(32 * 32);
+    std::vector<std::uint8_t> mask(32 * 32);
+    for (std::size_t i = 0; i < potential.size(); i++) {
+        field[2 * i] = 0.001f * static_cast<float>(i % 5);
+        potential[i] = 0.01f * static_cast<float>(i % 32);
+        mask[i] = (i / 32 >= 4 && i / 32 < 6 && i % 32 >= 20 && i % 32 < 26) ? 1 : 0;
+    }
+    const std::uint32_t cell[3] = {3, 3, 0}, wall[3] = {10, 8, 0};
+    const float force[3] = {0.0f, 0.01f, 0.0f}, normal[3] = {0.0f, 1.0f, 0.0f};
+    w.set_force_field(field);
+    CHECK(mpca_world_set_force_field(c, field.data(), field.size()) == MPCA_STATUS_OK);
+    w.set_cell_force({3, 3, 0}, {0.0f, 0.01f, 0.0f});
+    CHECK(mpca_world_set_cell_force(c, cell, force) == MPCA_STATUS_OK);
+    w.set_potential(potential);
+    CHECK(mpca_world_set_potential(c, potential.data(), potential.size()) == MPCA_STATUS_OK);
+    w.set_cell_potential({3, 3, 0}, 0.5f);
+    CHECK(mpca_world_set_cell_potential(c, cell, 0.5f) == MPCA_STATUS_OK);
+    w.set_vortex(12.0f, 14.0f, 2.0f, -0.3f);
+    CHECK(mpca_world_set_vortex(c, 12.0f, 14.0f, 2.0f, -0.3f) == MPCA_STATUS_OK);
+    w.add_obstacle({10, 8, 0}, {0.0f, 1.0f, 0.0f}, 0.9f);
+    CHECK(mpca_world_add_obstacle(c, wall, normal, 0.9f) == MPCA_STATUS_OK);
+    w.add_obstacle_mask(mask, 0.8f);
+    CHECK(mpca_world_add_obstacle_mask(c, mask.data(), mask.size(), 0.8f) == MPCA_STATUS_OK);
+    const mpca::surface s = w.surface({10, 8, 0});
+    CHECK(s.normal[1] == 1.0f && s.restitution == 0.9f);
+    THROWS(MPCA_STATUS_NOT_A_SURFACE, w.surface({1, 1, 0}));
+    THROWS(MPCA_STATUS_NOT_FINITE, w.set_cell_potential({3, 3, 0}, std::numeric_limits<float>::infinity()));
+    fill_box(w);
+    for (std::uint32_t x = 2; x < 30; x++) {
+        for (std::uint32_t y = 20; y < 24; y++) {
+            std::uint32_t pos[3] = {x, y, 0};
+            float v[3] = {speed(x), x % 3 == 0 ? 0.1f : -0.1f, 0.0f};
+            CHECK((x % 3 == 0 ? mpca_world_add_particle_mass(c, pos, v, 2.0f) : mpca_world_add_particle(c, pos, v)) ==
+                  MPCA_STATUS_OK);
+        }
+    }
+    w.step(30);
+    CHECK(mpca_world_step(c, 30) == MPCA_STATUS_OK);
+    std::uint64_t c_hash = 0;
+    CHECK(mpca_world_hash(c, &c_hash) == MPCA_STATUS_OK && w.hash() == c_hash);
+    mpca_world_destroy(c);
+    std::printf("cpp: the rest\n");
+}
+
+/* `wrapper` is the wrapper of `c_function`: its address is taken and the
+ * name printed. A constructor has no address: WRAPS_CONSTRUCTOR checks it
+ * exists for the arguments. */
+#define WRAPS(c_function, wrapper)                          \
+    do {                                                    \
+        (void)&c_function;                                  \
+        CHECK((wrapper) != nullptr);                        \
+        std::printf("wraps: %s\n", #c_function);            \
+    } while (0)
+#define WRAPS_CONSTRUCTOR(c_function, type, ...)            \
+    do {                                                    \
+        (void)&c_function;                                  \
+        CHECK((std::is_constructible<type, __VA_ARGS__>::value)); \
+        std::printf("wraps: %s\n", #c_function);            \
+    } while (0)
+
+static void every_function() {
+    typedef mpca::world W;
+    typedef std::function<void(const mpca::tasks &)> host;
+    WRAPS(mpca_version, &mpca::version);
+    WRAPS(mpca_desc_defaults, &mpca::desc_2d);
+    WRAPS(mpca_desc_defaults, &mpca::desc_3d);
+    WRAPS(mpca_desc_validate, &mpca::validate);
+    WRAPS(mpca_desc_from_image, &mpca::desc_from_image);
+    WRAPS_CONSTRUCTOR(mpca_status_message, mpca::error, mpca_status);
+    WRAPS(mpca_world_bytes, &mpca::world_bytes);
+    WRAPS_CONSTRUCTOR(mpca_world_create, W, const mpca_desc &);
+    WRAPS(mpca_world_destroy, &W::reset);
+    WRAPS(mpca_world_init, &W::init);
+    WRAPS(mpca_world_init_from_image, &W::init_from_image);
+    WRAPS(mpca_world_deinit, &W::reset);
+    WRAPS(mpca_world_add_particle, static_cast<void (W::*)(const mpca::cell_pos &, const mpca::vec3 &)>(&W::add_particle));
+    WRAPS(mpca_world_add_particle_mass,
+          static_cast<void (W::*)(const mpca::cell_pos &, const mpca::vec3 &, float)>(&W::add_particle));
+    WRAPS(mpca_world_remove_particle, &W::remove_particle);
+    WRAPS(mpca_world_cell, &W::cell);
+    WRAPS(mpca_world_particle_count, &W::particle_count);
+    WRAPS(mpca_world_step, &W::step);
+    WRAPS(mpca_world_step_parallel, &W::step_parallel<host &>);
+    WRAPS(mpca_world_step_task, &mpca::tasks::run);
+    WRAPS(mpca_world_stats, &W::stats);
+    WRAPS(mpca_world_hash, &W::hash);
+    WRAPS(mpca_world_desc, &W::desc);
+    WRAPS(mpca_world_export_positions, &W::export_positions);
+    WRAPS(mpca_world_export_velocities, &W::export_velocities);
+    WRAPS(mpca_world_export_masses, &W::export_masses);
+    WRAPS(mpca_world_density, &W::density);
+    WRAPS(mpca_world_density_u8, &W::density_u8);
+    WRAPS(mpca_world_region_stats, &W::region_stats);
+    WRAPS(mpca_world_snapshot_bytes, &W::snapshot_bytes);
+    WRAPS(mpca_world_save, static_cast<std::size_t (W::*)(void *, std::size_t) const>(&W::save));
+    WRAPS(mpca_world_load, static_cast<void (W::*)(const void *, std::size_t)>(&W::load));
+    WRAPS(mpca_world_set_gravity, &W::set_gravity);
+    WRAPS(mpca_world_set_wind_field, &W::set_wind_field);
+    WRAPS(mpca_world_set_cell_wind, &W::set_cell_wind);
+    WRAPS(mpca_world_set_force_field, &W::set_force_field);
+    WRAPS(mpca_world_set_cell_force, &W::set_cell_force);
+    WRAPS(mpca_world_set_potential, &W::set_potential);
+    WRAPS(mpca_world_set_cell_potential, &W::set_cell_potential);
+    WRAPS(mpca_world_set_vortex, &W::set_vortex);
+    WRAPS(mpca_world_add_box, &W::add_box);
+    WRAPS(mpca_world_add_disc, &W::add_disc);
+    WRAPS(mpca_world_add_sphere, &W::add_sphere);
+    WRAPS(mpca_world_add_half_space, &W::add_half_space);
+    WRAPS(mpca_world_add_obstacle, &W::add_obstacle);
+    WRAPS(mpca_world_add_obstacle_mask, &W::add_obstacle_mask);
+    WRAPS(mpca_world_surface, &W::surface);
+    WRAPS(mpca_world_add_emitter, &W::add_emitter);
+    WRAPS(mpca_world_set_emitter_rate, &W::set_emitter_rate);
+    std::printf("cpp: every function\n");
+}
+
 int main() {
 #if defined(CPP_ASAN)
     std::printf("sanitizer: address\n");
@@ -394,6 +583,8 @@ int main() {
     errors();
     same_as_c();
     parallel();
+    the_rest();
+    every_function();
     std::printf("cpp checks: %u failed: %u\n", checks, failed);
     return failed == 0 ? 0 : 1;
 }

@@ -7,3 +7,10 @@ pub mod plot;
 pub mod scenes;
 pub mod setup;
 pub mod table;
+
+/// The workspace README's Rust examples, each a whole `main.rs`
+/// (tests/readme.rs holds them to that), compiled and run as doctests so
+/// they stay true.
+#[cfg(doctest)]
+#[doc = include_str!("../../README.md")]
+struct ReadmeExamples;

@@ -155,6 +155,42 @@ impl Stream {
     }
 }
 
+/// The stream as a generator of the `rand_core` ecosystem (its `Rng`, the
+/// infallible `TryRng`), so that users and tests can draw from a world's
+/// streams with the ecosystem's tools (`rand`'s distributions, say).
+/// `next_u32` takes 32 bits as [`Stream::bits`] does, so two of them use
+/// one output; `next_u64` and `fill_bytes` take whole outputs, least
+/// significant byte first.
+///
+/// ```
+/// use rand_core::Rng;
+///
+/// // The stream block 5 of a world seeded 42 draws from at step 0.
+/// let mut stream = mpca::rng::block_stream(42, 0, 5);
+/// let mut bytes = [0u8; 16];
+/// stream.fill_bytes(&mut bytes);
+/// let again = mpca::rng::block_stream(42, 0, 5).next_u64();
+/// assert_eq!(bytes[..8], again.to_le_bytes());
+/// ```
+impl rand_core::TryRng for Stream {
+    type Error = core::convert::Infallible;
+
+    #[inline]
+    fn try_next_u32(&mut self) -> Result<u32, Self::Error> {
+        Ok(self.bits(32))
+    }
+
+    #[inline]
+    fn try_next_u64(&mut self) -> Result<u64, Self::Error> {
+        Ok(Stream::next_u64(self))
+    }
+
+    #[inline]
+    fn try_fill_bytes(&mut self, dst: &mut [u8]) -> Result<(), Self::Error> {
+        rand_core::utils::fill_bytes_via_next_word(dst, || self.try_next_u64())
+    }
+}
+
 /// `a % n` (`n >= 1`) by shifts and subtractions, a bit at a time: the
 /// rejection threshold of [`Stream::below`], which a draw needs once in
 /// thousands, without the division routine that small cores (Cortex-M0)
@@ -230,6 +266,26 @@ mod tests {
         s.bits(16);
         s.bits(32);
         assert_eq!(u64::from(s.bits(24)), t.next_u64() & 0xff_ffff);
+    }
+
+    #[test]
+    fn the_rand_core_generator_is_the_stream() {
+        // Through rand_core's Rng: next_u64 is the stream's output, two
+        // next_u32 are one output's halves, lowest first, and fill_bytes
+        // lays outputs down little-endian, dropping the unused rest.
+        use rand_core::Rng;
+        let mut direct = block_stream(11, 12, 13);
+        let mut rng = direct.clone();
+        let first = direct.next_u64();
+        assert_eq!(Rng::next_u64(&mut rng), first);
+        let second = direct.next_u64();
+        assert_eq!(u64::from(rng.next_u32()), second & 0xffff_ffff);
+        assert_eq!(u64::from(rng.next_u32()), second >> 32);
+        let mut bytes = [0u8; 11];
+        rng.fill_bytes(&mut bytes);
+        let (a, b) = (direct.next_u64().to_le_bytes(), direct.next_u64().to_le_bytes());
+        assert_eq!(bytes[..8], a);
+        assert_eq!(bytes[8..], b[..3]);
     }
 
     #[test]
