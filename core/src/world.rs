@@ -158,6 +158,29 @@ impl World {
     /// `'a`. A retired world, or memory that never held one, is refused by its
     /// tag.
     pub unsafe fn from_ptr<'a>(ptr: *mut u8) -> Result<&'a mut World, Error> {
+        // SAFETY: the caller's promise, passed on; the pointer is the one
+        // the caller handed in, with its permission to write.
+        Ok(unsafe { &mut *Self::checked(ptr)? })
+    }
+
+    /// [`World::from_ptr`] for reading only: the world may be shared with
+    /// other readers for `'a`, as calls that only read it are (mpca-ffi
+    /// lets several run at once, and no `&mut World` may exist then).
+    ///
+    /// # Safety
+    /// As for [`World::from_ptr`], except that the memory may also be read,
+    /// never written, through other references for `'a`.
+    pub unsafe fn from_ptr_ref<'a>(ptr: *const u8) -> Result<&'a World, Error> {
+        // SAFETY: the caller's promise, passed on.
+        Ok(unsafe { &*Self::checked(ptr.cast_mut())? })
+    }
+
+    /// The world at `ptr` if its tag says one was built there, without
+    /// forming a reference to it.
+    ///
+    /// # Safety
+    /// As for [`World::from_ptr`].
+    unsafe fn checked(ptr: *mut u8) -> Result<*mut World, Error> {
         if ptr.is_null() || (ptr as usize) % WORLD_ALIGN != 0 {
             return Err(Error::NotAWorld);
         }
@@ -169,8 +192,8 @@ impl World {
         if tag != TAG ^ ptr as u64 {
             return Err(Error::NotAWorld);
         }
-        // SAFETY: the tag says a world was built here with `len` plane bytes.
-        Ok(unsafe { &mut *(core::ptr::slice_from_raw_parts_mut(ptr, len) as *mut World) })
+        // The tag says a world was built here with `len` plane bytes.
+        Ok(core::ptr::slice_from_raw_parts_mut(ptr, len) as *mut World)
     }
 
     /// The address [`World::from_ptr`] takes back.
