@@ -158,29 +158,18 @@ impl World {
     /// `'a`. A retired world, or memory that never held one, is refused by its
     /// tag.
     pub unsafe fn from_ptr<'a>(ptr: *mut u8) -> Result<&'a mut World, Error> {
-        // SAFETY: the caller's promise, passed on; the pointer is the one
-        // the caller handed in, with its permission to write.
-        Ok(unsafe { &mut *Self::checked(ptr)? })
-    }
-
-    /// [`World::from_ptr`] for reading only: the world may be shared with
-    /// other readers for `'a`, as calls that only read it are (mpca-ffi
-    /// lets several run at once, and no `&mut World` may exist then).
-    ///
-    /// # Safety
-    /// As for [`World::from_ptr`], except that the memory may also be read,
-    /// never written, through other references for `'a`.
-    pub unsafe fn from_ptr_ref<'a>(ptr: *const u8) -> Result<&'a World, Error> {
         // SAFETY: the caller's promise, passed on.
-        Ok(unsafe { &*Self::checked(ptr.cast_mut())? })
+        Ok(unsafe { &mut *Self::from_ptr_raw(ptr)? })
     }
 
-    /// The world at `ptr` if its tag says one was built there, without
-    /// forming a reference to it.
+    /// [`World::from_ptr`] without forming a reference: the caller decides
+    /// whether to read only (a shared reference, where other calls may read
+    /// the world at the same time, as mpca-ffi lets them) or to write.
     ///
     /// # Safety
-    /// As for [`World::from_ptr`].
-    unsafe fn checked(ptr: *mut u8) -> Result<*mut World, Error> {
+    /// As for [`World::from_ptr`], for the header's check; what the caller
+    /// then does through the pointer is its own to justify.
+    pub unsafe fn from_ptr_raw(ptr: *mut u8) -> Result<*mut World, Error> {
         if ptr.is_null() || (ptr as usize) % WORLD_ALIGN != 0 {
             return Err(Error::NotAWorld);
         }

@@ -23,7 +23,7 @@ use crate::{mpca_status, mpca_world};
 pub(crate) use hosted::{claim, close_tasks, enter, issue, issue_owned, leave, open_tasks, reserve, revoke, run_task};
 
 #[cfg(not(feature = "hosted"))]
-pub(crate) use firmware::{claim, enter, issue, leave, reserve, revoke};
+pub(crate) use firmware::{claim, enter, issue, reserve, revoke};
 
 /// What a call does to the world it names, which decides what it may
 /// share the world with (hosted builds; the rule `mpca_world` states).
@@ -483,9 +483,6 @@ mod firmware {
     pub(crate) fn enter(handle: *const mpca_world, _: Access) -> Result<*mut u8, mpca_status> {
         Ok(handle.cast_mut().cast())
     }
-
-    /// Nothing to do: nothing was held.
-    pub(crate) fn leave(_: *const mpca_world, _: Access) {}
 
     /// Nothing to do: `World::retire` cleared the tag.
     pub(crate) fn revoke(_: *const mpca_world) {}
