@@ -660,7 +660,8 @@ typedef struct mpca_desc {
    */
   float drag_rate;
   /**
-   * The uniform part of the flow `u`, |drag_wind| <= 1.
+   * The uniform part of the flow `u`, |drag_wind| <= 1 (decided exactly
+   * for the floats given).
    */
   float drag_wind[3];
   /**
@@ -970,14 +971,17 @@ mpca_status mpca_world_set_vortex(struct mpca_world *world,
  * Replaces the wind plane (M5.1b): `dim` flow velocity components per
  * cell, cells x fastest; `len` must be `dim` times the cell count. Every
  * value finite (`MPCA_STATUS_NOT_FINITE`) and every cell's speed at most 1
- * (`MPCA_STATUS_SPEED_RANGE`), else nothing is set. Needs
+ * (`MPCA_STATUS_SPEED_RANGE`; decided exactly for the floats given, so
+ * (0.6, 0.8), whose squares sum to 1 + 2e-8, is over), else nothing is
+ * set. Needs
  * `mpca_desc.drag_wind_field`.
  */
 mpca_status mpca_world_set_wind_field(struct mpca_world *world, const float *wind, size_t len);
 
 /**
- * Sets the flow velocity (3 values, speed at most 1) of the cell at `pos`
- * in the wind plane (M5.1b).
+ * Sets the flow velocity (3 values, speed at most 1, decided exactly as
+ * for mpca_world_set_wind_field) of the cell at `pos` in the wind plane
+ * (M5.1b).
  */
 mpca_status mpca_world_set_cell_wind(struct mpca_world *world,
                                      const uint32_t *pos,

@@ -206,7 +206,7 @@ impl World {
         }
         finite(&v)?;
         let d = self.dim();
-        if velocity && !slow(v[..d].iter().copied()) {
+        if velocity && !crate::speed::slow(&v[..d]) {
             return Err(Error::SpeedRange);
         }
         plane(self.planes::<u8>().1)[s.cell * d..s.cell * d + d].copy_from_slice(&v[..d]);
@@ -239,7 +239,7 @@ impl World {
     pub fn set_wind_field(&mut self, wind: &[f32]) -> Result<(), Error> {
         let d = self.dim();
         self.force_plane_check(self.head.desc.drag.field, wind, d)?;
-        if wind.chunks_exact(d).any(|u| !slow(u.iter().copied())) {
+        if wind.chunks_exact(d).any(|u| !crate::speed::slow(u)) {
             return Err(Error::SpeedRange);
         }
         self.planes::<u8>().1.wind.copy_from_slice(wind);
@@ -256,11 +256,6 @@ impl World {
         let b = self.head.desc.boundary;
         [0, 1, 2].map(|k| b[k][0] == Boundary::Periodic)
     }
-}
-
-/// A velocity no faster than 1 (M1), in the components given.
-pub(crate) fn slow(u: impl IntoIterator<Item = f32>) -> bool {
-    u.into_iter().map(|c| c * c).sum::<f32>() <= 1.0
 }
 
 #[cfg(test)]

@@ -213,7 +213,7 @@ impl Layout {
         if d.drag.rate < 0.0 {
             return Err(Error::BadDrag);
         }
-        if !crate::force::slow(d.drag.wind[..dim].iter().copied()) {
+        if !crate::speed::slow(&d.drag.wind[..dim]) {
             return Err(Error::SpeedRange);
         }
         if d.drag.vortex && d.drag.rate > 0.0 && d.vortex.core_radius <= 0.0 {

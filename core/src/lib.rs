@@ -59,6 +59,7 @@ mod quant;
 mod query;
 pub mod rng;
 mod snapshot;
+mod speed;
 mod step;
 #[cfg(target_has_atomic = "8")]
 mod tasks;

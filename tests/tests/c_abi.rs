@@ -871,6 +871,19 @@ fn a_world_rebuilds_from_its_own_export() {
     run.assert_no_failures_in("a world rebuilt from its own export");
 }
 
+/// Every speed limit at 1 and one unit in the last place beyond it, in
+/// each direction, 2D and 3D: the wind cell, the wind field, the
+/// description's wind and an emitter refuse (0.6, 0.8), (1, 2e-4) and a
+/// unit component beside a subnormal one (all over 1, though their squares
+/// summed in f32 round to 1), changing nothing; a particle takes what a
+/// world can store, so only a component beyond 1 is refused.
+#[test]
+fn speed_limits_from_c_are_exact() {
+    let run = edges();
+    assert_eq!(run.value("speed limits: "), "29 velocities, each against 5 checks");
+    run.assert_no_failures_in("speed limits");
+}
+
 /// The README's C example (its first ```c block), compiled with the same
 /// strict flags, linked as the README's static line says (`libmpca.a -lm
 /// -lpthread -ldl`) and run. Expected: exit 0, and all 64 particles it adds still there
