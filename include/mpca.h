@@ -18,6 +18,13 @@
  * Buffers: an export that fills a caller's buffer and writes a count takes
  * NULL with capacity 0 as a size query (the count, MPCA_STATUS_OK).
  *
+ * Threads (hosted builds): calls on one world from several threads never
+ * race. Calls taking a const mpca_world * read it and run together; a call
+ * taking mpca_world * changes it and runs alone, after the reads inside
+ * return; a call the world is not free for is refused at once with
+ * MPCA_STATUS_BUSY, so a call completes before a step begins or is
+ * refused. See mpca_world for the whole rule.
+ *
  * Link, once installed (scripts/install.sh --prefix DIR):
  *   cc app.c $(pkg-config --cflags --libs mpca)
  * or from the build folder: cc app.c -Iinclude -Ltarget/release -lmpca;
@@ -100,8 +107,12 @@ enum mpca_status
    */
   MPCA_STATUS_NOT_A_SURFACE = 7,
   /**
-   * The world is inside mpca_world_step_parallel: only
-   * mpca_world_step_task reaches it until that returns.
+   * Another call is inside the world and this one cannot share it (the
+   * rule at `mpca_world`): a parallel step (only mpca_world_step_task
+   * reaches the world until it returns) or another call that changes
+   * it; or, for a call that ends or replaces the world (deinit, destroy,
+   * load, a world built over its memory), any call. Nothing was changed;
+   * the call may be made again.
    */
   MPCA_STATUS_BUSY = 8,
   /**
@@ -119,7 +130,9 @@ enum mpca_status
   MPCA_STATUS_TASK_DONE = 11,
   /**
    * Two memory ranges of the call overlap: an image and the memory of
-   * the world it is saved from, loaded into or built in.
+   * the world it is saved from, loaded into or built in; or the memory
+   * handed to mpca_world_init or mpca_world_init_from_image and a world
+   * mpca_world_create allocated (hosted builds).
    */
   MPCA_STATUS_OVERLAP = 12,
   /**
@@ -485,9 +498,28 @@ typedef uint32_t mpca_cell_kind;
  * allocator or by a new world; the address of a world or of a copy of its
  * bytes; any forged value. Building a world with mpca_world_init in memory
  * that holds a live world ends that world: its handle is refused from then
- * on. Where pointers are 32 bits wide the values run out after 2^32 - 1
+ * on (unless a call is inside it: see Threads). Where pointers are 32 bits wide the values run out after 2^32 - 1
  * worlds in a process; create and init then return
  * `MPCA_STATUS_OUT_OF_MEMORY`.
+ *
+ * Threads (hosted builds): a world may be used from any thread, and calls
+ * on it from several threads at once never race: the registry decides
+ * who is inside. A call taking `const mpca_world *` only reads the world,
+ * and any number of those run together. A call taking `mpca_world *`
+ * changes it (mpca_world_step_parallel included) and runs alone: it waits
+ * for the reading calls inside to return (they wait for nothing, so the
+ * wait ends) while new calls are refused, and it returns
+ * `MPCA_STATUS_BUSY` at once, changing nothing, when another changing call
+ * or a parallel step is inside. Calls that end or replace a world do not
+ * wait: mpca_world_deinit, mpca_world_destroy, mpca_world_load, and
+ * mpca_world_init or mpca_world_init_from_image over its memory, return
+ * `MPCA_STATUS_BUSY` while any call is inside it (from any thread, or from
+ * a task of its step) and leave it alive; init in memory of a world
+ * mpca_world_create allocated returns `MPCA_STATUS_OVERLAP`. During a
+ * parallel step only its mpca_world_step_task calls reach the world. So a
+ * call on a world completes before a step or change begins, or begins
+ * after it ends, or is refused; a program that wants a refused call done
+ * makes it again.
  *
  * Firmware builds (without `hosted`: no allocator, no registry): the handle
  * is the world's address in the caller's memory, and the world's header
@@ -504,7 +536,8 @@ typedef uint32_t mpca_cell_kind;
  * which is undefined behaviour if it is gone (as for any dangling pointer);
  * and once mpca_world_init builds a new world at the same address, the old
  * handle equals the new one and reaches the new world. End a world with
- * mpca_world_deinit and drop its handle before the memory is reused.
+ * mpca_world_deinit and drop its handle before the memory is reused. A
+ * firmware world is used by one call at a time.
  */
 typedef struct mpca_world mpca_world;
 
@@ -627,7 +660,8 @@ typedef struct mpca_desc {
    */
   float drag_rate;
   /**
-   * The uniform part of the flow `u`, |drag_wind| <= 1.
+   * The uniform part of the flow `u`, |drag_wind| <= 1 (decided exactly
+   * for the floats given).
    */
   float drag_wind[3];
   /**
@@ -937,14 +971,17 @@ mpca_status mpca_world_set_vortex(struct mpca_world *world,
  * Replaces the wind plane (M5.1b): `dim` flow velocity components per
  * cell, cells x fastest; `len` must be `dim` times the cell count. Every
  * value finite (`MPCA_STATUS_NOT_FINITE`) and every cell's speed at most 1
- * (`MPCA_STATUS_SPEED_RANGE`), else nothing is set. Needs
+ * (`MPCA_STATUS_SPEED_RANGE`; decided exactly for the floats given, so
+ * (0.6, 0.8), whose squares sum to 1 + 2e-8, is over), else nothing is
+ * set. Needs
  * `mpca_desc.drag_wind_field`.
  */
 mpca_status mpca_world_set_wind_field(struct mpca_world *world, const float *wind, size_t len);
 
 /**
- * Sets the flow velocity (3 values, speed at most 1) of the cell at `pos`
- * in the wind plane (M5.1b).
+ * Sets the flow velocity (3 values, speed at most 1, decided exactly as
+ * for mpca_world_set_wind_field) of the cell at `pos` in the wind plane
+ * (M5.1b).
  */
 mpca_status mpca_world_set_cell_wind(struct mpca_world *world,
                                      const uint32_t *pos,
@@ -1023,11 +1060,16 @@ mpca_status mpca_world_surface(const struct mpca_world *world,
  * `user_data`. The world is the one mpca_world_step gives, bit for bit,
  * whatever the task count, the order or the threads.
  *
- * What may run concurrently: while this call runs, only
- * mpca_world_step_task may be called on this world, from any thread and
- * concurrently for distinct tasks; any other call on it (this one
- * included, from another thread or from inside a task) returns
- * `MPCA_STATUS_BUSY` and changes nothing. Other worlds are unaffected.
+ * What may run concurrently (the rule at `mpca_world`): the step waits
+ * for the calls reading the world to return, refusing new ones, and
+ * returns `MPCA_STATUS_BUSY` at once, stepping nothing, when another
+ * changing call or a parallel step is inside. While it
+ * runs, only mpca_world_step_task may be called on this world, from any
+ * thread and concurrently for distinct tasks; any other call on it (this
+ * one included, from another thread or from inside a task; mpca_world_init
+ * or mpca_world_init_from_image over its memory too) returns
+ * `MPCA_STATUS_BUSY` and changes nothing. So a call on the world completes
+ * before the step begins, or is refused. Other worlds are unaffected.
  *
  * A task the host did not run is run on this thread before the step ends,
  * so a `run_tasks` that returns early still completes the step. Hosted
@@ -1222,7 +1264,9 @@ const char *mpca_status_message(uint32_t status);
  * allocated. The world stays valid until mpca_world_deinit or until the
  * memory is freed or reused; do not move or copy the memory meanwhile.
  * A world built over a live one ends it (see `mpca_world` for what its
- * handle then does).
+ * handle then does), unless a call is inside that one: then this returns
+ * `MPCA_STATUS_BUSY` and changes nothing (hosted builds; see Threads at
+ * `mpca_world`).
  */
 mpca_status mpca_world_init(const struct mpca_desc *desc,
                             void *memory,

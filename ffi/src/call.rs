@@ -14,13 +14,17 @@
 //! `unsafe` of their own.
 //!
 //! Handles are not caller memory: [`Call::world`] resolves one through the
-//! registry of `handle.rs` before anything is read.
+//! registry of `handle.rs` before anything is read, and enters the world
+//! there for as long as the call runs (the `Call` leaves it when dropped).
 
+#[cfg(feature = "hosted")]
+use core::cell::Cell;
 use core::marker::PhantomData;
 
 use mpca_core::World;
 
-use crate::{handle, mpca_status, mpca_world};
+use crate::handle::{self, Access};
+use crate::{mpca_status, mpca_world};
 
 /// One call of an export and its caller's promise (module docs). Only
 /// [`guard`] makes one; the references its accessors return live no longer
@@ -29,6 +33,21 @@ pub(crate) struct Call<'c> {
     /// Invariant in `'c`, and neither `Send` nor `Sync`: the promise holds
     /// on the caller's thread, for this call.
     _call: PhantomData<*mut &'c ()>,
+    /// The world this call entered in the registry, and for what; left
+    /// when the call ends. Firmware builds have no registry to leave.
+    #[cfg(feature = "hosted")]
+    entered: Cell<Option<(*const mpca_world, Access)>>,
+}
+
+#[cfg(feature = "hosted")]
+impl Drop for Call<'_> {
+    /// The call is over (returned, or unwinding to the panic boundary): no
+    /// reference it handed out is used any more.
+    fn drop(&mut self) {
+        if let Some((w, access)) = self.entered.take() {
+            handle::leave(w, access);
+        }
+    }
 }
 
 /// Runs an export's body with the caller's promise, inside the panic
@@ -40,7 +59,13 @@ pub(crate) struct Call<'c> {
 /// test `guard_is_called_only_by_exports` below checks the sources for it.
 #[inline]
 pub(crate) fn guard(body: impl for<'c> FnOnce(&Call<'c>) -> Result<(), mpca_status>) -> mpca_status {
-    let call = Call { _call: PhantomData };
+    let call = Call {
+        _call: PhantomData,
+        #[cfg(feature = "hosted")]
+        entered: Cell::new(None),
+    };
+    // The closure owns the call, so it is dropped (its world left) when the
+    // body returns or unwinds.
     let body = move || body(&call);
     #[cfg(feature = "catch-panics")]
     let result = match std::panic::catch_unwind(core::panic::AssertUnwindSafe(body)) {
@@ -140,27 +165,64 @@ impl<'c> Call<'c> {
         Ok(unsafe { core::slice::from_raw_parts_mut(p, len) })
     }
 
-    /// The world behind a handle; NULL and dead handles are refused. An
-    /// export asks for its world once.
-    pub(crate) fn world(&self, w: *mut mpca_world) -> Result<&'c mut World, mpca_status> {
+    /// Enters the world behind a handle for `access` until the call ends,
+    /// and returns where it is: NULL, dead handles and a world busy with
+    /// another call (hosted builds) are refused. An export enters one world.
+    pub(crate) fn enter(&self, w: *const mpca_world, access: Access) -> Result<*mut u8, mpca_status> {
         if w.is_null() {
             return Err(mpca_status::NullPointer);
         }
-        let at = handle::resolve(w)?;
+        let at = handle::enter(w, access)?;
+        #[cfg(feature = "hosted")]
+        {
+            debug_assert!(self.entered.get().is_none(), "a call enters one world");
+            self.entered.set(Some((w, access)));
+        }
+        Ok(at)
+    }
+
+    /// The world behind a handle, for a call that changes it.
+    #[inline]
+    pub(crate) fn world(&self, w: *mut mpca_world) -> Result<&'c mut World, mpca_status> {
+        let at = self.world_at(w, Access::Write)?;
+        // SAFETY: entered for Write (`world_at`): the registry lets no other
+        // call inside until this one ends, which `'c` does not outlive
+        // (firmware: one call at a time).
+        Ok(unsafe { &mut *at })
+    }
+
+    /// The world behind a handle, for a call that ends or replaces it
+    /// (deinit, load): refused with `Busy` while any call is inside.
+    #[inline]
+    pub(crate) fn world_to_end(&self, w: *mut mpca_world) -> Result<&'c mut World, mpca_status> {
+        let at = self.world_at(w, Access::End)?;
+        // SAFETY: as in `world`; End admits no other call either.
+        Ok(unsafe { &mut *at })
+    }
+
+    /// The world behind a handle, for a call that only reads it: others
+    /// may read it at the same time, none change it.
+    #[inline]
+    pub(crate) fn world_ref(&self, w: *const mpca_world) -> Result<&'c World, mpca_status> {
+        let at = self.world_at(w, Access::Read)?;
+        // SAFETY: entered for Read: while this call runs the registry lets
+        // only calls that read the world inside, and they hold shared
+        // references only.
+        Ok(unsafe { &*at })
+    }
+
+    /// Enters the world behind a handle for `access` and finds it. One
+    /// function behind the three above, so each export's call is small.
+    #[inline(never)]
+    fn world_at(&self, w: *const mpca_world, access: Access) -> Result<*mut World, mpca_status> {
+        let at = self.enter(w, access)?;
         // SAFETY: hosted builds: `at` is where a world was built and
         // registered, and its handle was not revoked since, so the memory
         // is that world's (the C contract: memory handed to mpca_world_init
-        // stays until deinit), and no other call is inside it (one thread
-        // at a time; a parallel step makes the registry answer Busy).
-        // Firmware builds: the C contract that a handle is an address this
-        // library returned, still readable. Either way `from_ptr` checks
-        // the tag before anything else is read.
-        unsafe { World::from_ptr(at) }.map_err(|_| mpca_status::BadHandle)
-    }
-
-    /// Read-only twin of [`Call::world`].
-    pub(crate) fn world_ref(&self, w: *const mpca_world) -> Result<&'c World, mpca_status> {
-        self.world(w.cast_mut()).map(|w| &*w)
+        // stays until deinit). Firmware builds: the C contract that a
+        // handle is an address this library returned, still readable.
+        // Either way the tag is checked before anything else is read.
+        unsafe { World::from_ptr_raw(at) }.map_err(|_| mpca_status::BadHandle)
     }
 }
 

@@ -128,7 +128,8 @@ pub struct mpca_desc {
     /// velocity relaxes towards the flow: v <- (v + dt rate u) / (1 + dt
     /// rate).
     pub drag_rate: f32,
-    /// The uniform part of the flow `u`, |drag_wind| <= 1.
+    /// The uniform part of the flow `u`, |drag_wind| <= 1 (decided exactly
+    /// for the floats given).
     pub drag_wind: [f32; 3],
     /// 1: the vortex (`vortex_*`) read as a velocity field adds to the flow.
     pub drag_vortex: u32,

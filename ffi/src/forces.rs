@@ -68,7 +68,9 @@ pub unsafe extern "C" fn mpca_world_set_vortex(world: *mut mpca_world, cx: f32, 
 /// Replaces the wind plane (M5.1b): `dim` flow velocity components per
 /// cell, cells x fastest; `len` must be `dim` times the cell count. Every
 /// value finite (`MPCA_STATUS_NOT_FINITE`) and every cell's speed at most 1
-/// (`MPCA_STATUS_SPEED_RANGE`), else nothing is set. Needs
+/// (`MPCA_STATUS_SPEED_RANGE`; decided exactly for the floats given, so
+/// (0.6, 0.8), whose squares sum to 1 + 2e-8, is over), else nothing is
+/// set. Needs
 /// `mpca_desc.drag_wind_field`.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_world_set_wind_field(world: *mut mpca_world, wind: *const f32, len: usize) -> mpca_status {
@@ -78,8 +80,9 @@ pub unsafe extern "C" fn mpca_world_set_wind_field(world: *mut mpca_world, wind:
     })
 }
 
-/// Sets the flow velocity (3 values, speed at most 1) of the cell at `pos`
-/// in the wind plane (M5.1b).
+/// Sets the flow velocity (3 values, speed at most 1, decided exactly as
+/// for mpca_world_set_wind_field) of the cell at `pos` in the wind plane
+/// (M5.1b).
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_world_set_cell_wind(world: *mut mpca_world, pos: *const u32, wind: *const f32) -> mpca_status {
     guard(|c| {

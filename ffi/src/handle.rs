@@ -5,7 +5,11 @@
 //! the world's address, and no number is issued twice in a process. A
 //! registry maps the live ones to their worlds, and is asked before any
 //! memory is read, so a handle whose world ended is refused whatever has
-//! since happened to that memory.
+//! since happened to that memory. The registry also knows who is inside
+//! each world, and refuses with `Busy` a call that would share it with a
+//! call that changes it: every export enters its world for the call's
+//! length (`Call::world`), and mpca_world_init claims the memory it
+//! builds in ([`claim`]). That is the rule for threads `mpca_world` states.
 //!
 //! Firmware builds (no `hosted`, so no registry): the handle is the world's
 //! address, and only the tag in the world's header tells a live world from
@@ -16,10 +20,24 @@ use mpca_core::World;
 use crate::{mpca_status, mpca_world};
 
 #[cfg(feature = "hosted")]
-pub(crate) use hosted::{begin_step, close_tasks, end_step, issue, issue_owned, open_tasks, reserve, resolve, revoke, run_task};
+pub(crate) use hosted::{claim, close_tasks, enter, issue, issue_owned, leave, open_tasks, reserve, revoke, run_task};
 
 #[cfg(not(feature = "hosted"))]
-pub(crate) use firmware::{issue, reserve, resolve, revoke};
+pub(crate) use firmware::{claim, enter, issue, reserve, revoke};
+
+/// What a call does to the world it names, which decides what it may
+/// share the world with (hosted builds; the rule `mpca_world` states).
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+pub(crate) enum Access {
+    /// Reads it only (the exports taking `const mpca_world *`): any number
+    /// of these at once.
+    Read,
+    /// Changes it, alone: waits for the reading calls inside to return.
+    Write,
+    /// Ends or replaces it (deinit, destroy, load), alone: refused while
+    /// any call is inside, as a world built over its memory is.
+    End,
+}
 
 #[cfg(feature = "hosted")]
 mod hosted {
@@ -28,23 +46,40 @@ mod hosted {
 
     use crate::sys::{Held, Lock};
 
-    use super::{mpca_status, mpca_world, World};
+    use super::{mpca_status, mpca_world, Access, World};
 
     /// A live world: where it starts, how many bytes it spans, whether the
-    /// library allocated it, and whether a parallel step holds it.
+    /// library allocated it, and who is inside it.
     struct Entry {
         at: NonNull<u8>,
         bytes: usize,
         owned: bool,
-        step: Step,
+        using: Use,
     }
 
-    /// Where a world is in mpca_world_step_parallel (M11).
-    enum Step {
-        /// Not in it: every call may reach the world.
-        Idle,
-        /// In it, between the host's task runs: no call reaches the world.
-        Busy,
+    impl Entry {
+        /// Whether its memory shares a byte with `start..end`.
+        fn overlaps(&self, start: usize, end: usize) -> bool {
+            let s = self.at.as_ptr() as usize;
+            s < end && start < s + self.bytes
+        }
+    }
+
+    /// Who is inside a world. A call the state does not admit is refused
+    /// with `Busy` at once. The one wait: a changing call waits for the
+    /// reading calls inside to return, and those wait for nothing and call
+    /// nothing of the program's, so the wait ends, whatever thread or task
+    /// the changing call comes from.
+    enum Use {
+        /// Calls that only read it, this many (0: no call at all).
+        Read(u32),
+        /// A changing call waits for this many reading calls to return;
+        /// new calls are refused.
+        Draining(u32),
+        /// One call that changes it: an edit, a step, a load, its end, a
+        /// world being built over its memory, or mpca_world_step_parallel
+        /// between the host's task runs.
+        Write,
         /// The host is running the tasks of one step: only
         /// mpca_world_step_task with this step's ticket reaches it.
         Tasks(Tasks),
@@ -68,11 +103,9 @@ mod hosted {
     struct TaskRef(*const (dyn Fn(usize) + Sync + 'static));
 
     // SAFETY: the registry stores the address and hands it back; it never
-    // reads or writes the world through it. Who uses the world, from which
-    // thread, is the C contract's business (one thread at a time), except
-    // during a parallel step, when the registry itself refuses every call
-    // but the step's tasks. The task pointer is called only as `TaskRef`
-    // says, and the task is `Sync`.
+    // reads or writes the world through it. Which calls reach the world at
+    // once is what `Use` decides, under the registry's lock. The task
+    // pointer is called only as `TaskRef` says, and the task is `Sync`.
     unsafe impl Send for Entry {}
 
     struct Registry {
@@ -92,11 +125,6 @@ mod hosted {
     struct Live(Vec<(usize, Entry)>);
 
     impl Live {
-        fn get(&self, handle: &usize) -> Option<&Entry> {
-            let i = self.0.binary_search_by_key(handle, |&(h, _)| h).ok()?;
-            Some(&self.0[i].1)
-        }
-
         fn get_mut(&mut self, handle: &usize) -> Option<&mut Entry> {
             let i = self.0.binary_search_by_key(handle, |&(h, _)| h).ok()?;
             Some(&mut self.0[i].1)
@@ -115,17 +143,18 @@ mod hosted {
             }
         }
 
-        fn retain(&mut self, mut keep: impl FnMut(&usize, &mut Entry) -> bool) {
-            self.0.retain_mut(|(h, e)| keep(h, e));
+        /// The entries whose memory shares a byte with `start..end`.
+        fn overlapping(&mut self, start: usize, end: usize) -> impl Iterator<Item = &mut Entry> {
+            self.0.iter_mut().map(|(_, e)| e).filter(move |e| e.overlaps(start, end))
         }
     }
 
     static REGISTRY: Lock<Registry> = Lock::new(Registry { taken: 0, tickets: 0, live: Live(Vec::new()) });
 
     fn registry() -> Held<'static, Registry> {
-        // Every change below is one insert, remove or retain, so a panic
-        // while the lock was held (caught with catch-panics; the lock is
-        // freed as it unwinds) left nothing half-done.
+        // Every change below is one insert, remove, retain or state change,
+        // so a panic while the lock was held (caught with catch-panics; the
+        // lock is freed as it unwinds) left nothing half-done.
         REGISTRY.lock()
     }
 
@@ -154,78 +183,139 @@ mod hosted {
         Ok(Reserved(r.taken))
     }
 
-    /// Registers a world just built and returns its handle. A world built in
-    /// caller memory that held live worlds ends them: their handles are
+    /// Caller memory a world is about to be built in, held from the check
+    /// until the world is registered ([`issue`]) or the call is refused
+    /// (dropped): the live worlds in it are held as a changing call holds
+    /// its world, so no call reaches them meanwhile.
+    pub(crate) struct Claim {
+        start: usize,
+        end: usize,
+    }
+
+    /// Claims the `len` bytes at `at` for a new world. Refused, claiming
+    /// nothing: with `Busy` when a live world there is in use (a call is
+    /// inside it, or a parallel step), whichever thread or task asks; with
+    /// `Overlap` when the library allocated a world there (caller memory
+    /// never holds one: that memory is the library's until
+    /// mpca_world_destroy).
+    pub(crate) fn claim(at: *mut u8, len: usize) -> Result<Claim, mpca_status> {
+        let (start, end) = (at as usize, (at as usize).saturating_add(len));
+        let mut r = registry();
+        let mut refusal = None;
+        for e in r.live.overlapping(start, end) {
+            if !matches!(e.using, Use::Read(0)) {
+                return Err(mpca_status::Busy);
+            }
+            if e.owned {
+                refusal = Some(mpca_status::Overlap);
+            }
+        }
+        if let Some(s) = refusal {
+            return Err(s);
+        }
+        for e in r.live.overlapping(start, end) {
+            e.using = Use::Write;
+        }
+        Ok(Claim { start, end })
+    }
+
+    impl Drop for Claim {
+        /// The world was not built: the worlds in the memory live on,
+        /// unchanged (every refusal comes before the memory is written).
+        fn drop(&mut self) {
+            for e in registry().live.overlapping(self.start, self.end) {
+                e.using = Use::Read(0);
+            }
+        }
+    }
+
+    /// Registers a world just built in claimed caller memory and returns
+    /// its handle. The live worlds that memory held end: their handles are
     /// refused from now on.
-    pub(crate) fn issue(number: Reserved, world: &mut World) -> *mut mpca_world {
-        let entry = Entry { at: NonNull::from(&mut *world).cast(), bytes: world.size_in_bytes(), owned: world.is_owned(), step: Step::Idle };
-        register(number, entry)
+    pub(crate) fn issue(number: Reserved, claim: Claim, world: &mut World) -> *mut mpca_world {
+        let entry = Entry { at: NonNull::from(&mut *world).cast(), bytes: world.size_in_bytes(), owned: false, using: Use::Read(0) };
+        let handle = value(number.0);
+        let mut r = registry();
+        r.live.0.retain(|(_, e)| !e.overlaps(claim.start, claim.end));
+        r.live.insert(handle, entry);
+        // Nothing is left to release: the claimed entries are gone.
+        core::mem::forget(claim);
+        core::ptr::without_provenance_mut(handle)
     }
 
     /// Registers a world the library allocated, by the pointer
     /// `WorldBox::into_raw` gives: the allocation's own, which
     /// mpca_world_destroy frees through (one derived from the `&mut World`
-    /// would not reach the allocation's alignment slack).
+    /// would not reach the allocation's alignment slack). Worlds the
+    /// registry still knows in that memory were freed by the caller
+    /// without mpca_world_deinit: they end.
     pub(crate) fn issue_owned(number: Reserved, world: mpca_core::WorldBox) -> *mut mpca_world {
         let bytes = world.size_in_bytes();
         let at = NonNull::new(world.into_raw()).expect("an allocation is not NULL");
-        register(number, Entry { at, bytes, owned: true, step: Step::Idle })
-    }
-
-    fn register(number: Reserved, entry: Entry) -> *mut mpca_world {
         let handle = value(number.0);
         let mut r = registry();
-        if !entry.owned {
-            let (start, end) = (entry.at.as_ptr() as usize, entry.at.as_ptr() as usize + entry.bytes);
-            r.live.retain(|_, e| {
-                let (s, t) = (e.at.as_ptr() as usize, e.at.as_ptr() as usize + e.bytes);
-                e.owned || t <= start || end <= s
-            });
-        }
-        r.live.insert(handle, entry);
+        let start = at.as_ptr() as usize;
+        r.live.0.retain(|(_, e)| !e.overlaps(start, start + bytes));
+        r.live.insert(handle, Entry { at, bytes, owned: true, using: Use::Read(0) });
         core::ptr::without_provenance_mut(handle)
     }
 
-    /// Where the world of a live handle is; `BadHandle` for anything else,
-    /// found without reading any memory `handle` might point to, and `Busy`
-    /// while a parallel step holds the world.
+    /// Enters the world of a live handle for a call that does `access` to
+    /// it and returns where the world is; [`leave`] must follow when the
+    /// call ends. `BadHandle` for anything but a live handle, found without
+    /// reading any memory `handle` might point to. `Busy` when the world's
+    /// state does not admit the call: a changing call or a parallel step is
+    /// inside (or waiting to be), or, for a call that ends the world, any
+    /// call is. A changing call finding reading calls inside waits for them.
     // Not inlined: every export calls it, and the lock and the map search
     // inlined into each made libmpca.so 8.5 KB larger (403,864 against
     // 395,360 bytes stripped); the call costs a few instructions a call.
     #[inline(never)]
-    pub(crate) fn resolve(handle: *const mpca_world) -> Result<*mut u8, mpca_status> {
-        let r = registry();
-        let e = r.live.get(&handle.addr()).ok_or(mpca_status::BadHandle)?;
-        match e.step {
-            Step::Idle => Ok(e.at.as_ptr()),
-            _ => Err(mpca_status::Busy),
-        }
-    }
-
-    /// Starts a parallel step on a live, idle world: every other call on
-    /// it is refused with `Busy` until [`end_step`].
-    pub(crate) fn begin_step(handle: *const mpca_world) -> Result<*mut u8, mpca_status> {
-        let mut r = registry();
-        let e = r.live.get_mut(&handle.addr()).ok_or(mpca_status::BadHandle)?;
-        match e.step {
-            Step::Idle => {
-                e.step = Step::Busy;
-                Ok(e.at.as_ptr())
+    pub(crate) fn enter(handle: *const mpca_world, access: Access) -> Result<*mut u8, mpca_status> {
+        {
+            let mut r = registry();
+            let e = r.live.get_mut(&handle.addr()).ok_or(mpca_status::BadHandle)?;
+            e.using = match (&e.using, access) {
+                (&Use::Read(n), Access::Read) => Use::Read(n.checked_add(1).ok_or(mpca_status::Busy)?),
+                (Use::Read(0), Access::Write | Access::End) => Use::Write,
+                (&Use::Read(n), Access::Write) => Use::Draining(n),
+                _ => return Err(mpca_status::Busy),
+            };
+            if !matches!(e.using, Use::Draining(_)) {
+                return Ok(e.at.as_ptr());
             }
-            _ => Err(mpca_status::Busy),
+        }
+        // Draining: the readers leave without waiting, and nothing else
+        // enters, ends or claims the world meanwhile.
+        loop {
+            crate::sys::yield_now();
+            let mut r = registry();
+            let e = r.live.get_mut(&handle.addr()).ok_or(mpca_status::BadHandle)?;
+            if let Use::Draining(0) = e.using {
+                e.using = Use::Write;
+                return Ok(e.at.as_ptr());
+            }
         }
     }
 
-    /// Ends the parallel step [`begin_step`] started.
-    pub(crate) fn end_step(handle: *const mpca_world) {
+    /// Ends a call's [`enter`]. A handle the call ended (deinit, destroy)
+    /// is gone from the registry, and nothing is left to do.
+    #[inline(never)]
+    pub(crate) fn leave(handle: *const mpca_world, access: Access) {
         if let Some(e) = registry().live.get_mut(&handle.addr()) {
-            e.step = Step::Idle;
+            match (&mut e.using, access) {
+                (Use::Read(n) | Use::Draining(n), Access::Read) => *n = n.saturating_sub(1),
+                (Use::Write, Access::Write | Access::End) => e.using = Use::Read(0),
+                // Not reached: a call's state is what its enter made it, or
+                // Write again after close_tasks.
+                _ => {}
+            }
         }
     }
 
     /// Hands the tasks of one step to mpca_world_step_task and returns
-    /// the step's ticket. [`close_tasks`] must follow before `task` is
-    /// dropped.
+    /// the step's ticket. The world must be entered for `Write` by this
+    /// call; [`close_tasks`] must follow before `task` is dropped.
     pub(crate) fn open_tasks(handle: *const mpca_world, count: usize, task: &(dyn Fn(usize) + Sync)) -> u64 {
         let mut r = registry();
         r.tickets += 1;
@@ -235,20 +325,21 @@ mod hosted {
         // until no call through it is running.
         let task: *const (dyn Fn(usize) + Sync + 'static) = unsafe { core::mem::transmute(task) };
         if let Some(e) = r.live.get_mut(&handle.addr()) {
-            e.step = Step::Tasks(Tasks { ticket, count, claimed: 0, running: 0, task: TaskRef(task) });
+            e.using = Use::Tasks(Tasks { ticket, count, claimed: 0, running: 0, task: TaskRef(task) });
         }
         ticket
     }
 
     /// Takes the step's tasks back once none is running: later calls of
-    /// mpca_world_step_task with its ticket are refused.
+    /// mpca_world_step_task with its ticket are refused, and the world is
+    /// the stepping call's alone again (`Write`).
     pub(crate) fn close_tasks(handle: *const mpca_world) {
         loop {
             {
                 let mut r = registry();
                 let Some(e) = r.live.get_mut(&handle.addr()) else { return };
-                if !matches!(&e.step, Step::Tasks(t) if t.running > 0) {
-                    e.step = Step::Busy;
+                if !matches!(&e.using, Use::Tasks(t) if t.running > 0) {
+                    e.using = Use::Write;
                     return;
                 }
             }
@@ -263,7 +354,7 @@ mod hosted {
         let task = {
             let mut r = registry();
             let e = r.live.get_mut(&handle.addr()).ok_or(mpca_status::BadHandle)?;
-            let Step::Tasks(t) = &mut e.step else { return Err(mpca_status::StaleTask) };
+            let Use::Tasks(t) = &mut e.using else { return Err(mpca_status::StaleTask) };
             if t.ticket != ticket {
                 return Err(mpca_status::StaleTask);
             }
@@ -282,7 +373,7 @@ mod hosted {
         struct Returned(*const mpca_world);
         impl Drop for Returned {
             fn drop(&mut self) {
-                if let Some(Entry { step: Step::Tasks(t), .. }) = registry().live.get_mut(&self.0.addr()) {
+                if let Some(Entry { using: Use::Tasks(t), .. }) = registry().live.get_mut(&self.0.addr()) {
                     t.running -= 1;
                 }
             }
@@ -294,14 +385,58 @@ mod hosted {
         Ok(())
     }
 
-    /// Ends a handle: it is refused from now on.
+    /// Ends a handle: it is refused from now on. Called by the call that
+    /// holds the world for `Write`, so no other call is inside it.
     pub(crate) fn revoke(handle: *const mpca_world) {
         registry().live.remove(&handle.addr());
     }
 
     #[cfg(test)]
     mod tests {
-        use super::value;
+        use super::*;
+        use crate::*;
+
+        #[test]
+        fn memory_in_use_or_the_librarys_own_is_not_claimed() {
+            use core::ptr::null_mut;
+            // SAFETY, for every export below: each pointer is a live local
+            // of the size the header asks for.
+            unsafe {
+                let mut d = core::mem::MaybeUninit::<mpca_desc>::uninit();
+                assert_eq!(mpca_desc_defaults(d.as_mut_ptr(), 2, 8, 6, 0), mpca_status::Ok);
+                let d = d.assume_init();
+                let mut owned = null_mut();
+                assert_eq!(mpca_world_create(&d, &mut owned), mpca_status::Ok);
+                let (at, bytes) = {
+                    let mut r = registry();
+                    let e = r.live.get_mut(&owned.addr()).expect("a live world");
+                    (e.at.as_ptr(), e.bytes)
+                };
+                // No caller owns the library's allocation: refused, whole or
+                // in part, and the world lives on.
+                assert!(matches!(claim(at, bytes), Err(mpca_status::Overlap)));
+                assert!(matches!(claim(at.wrapping_add(bytes / 2), 16), Err(mpca_status::Overlap)));
+                // A call inside: every claim and every end is refused.
+                assert!(enter(owned, Access::Read).is_ok());
+                assert!(matches!(claim(at, bytes), Err(mpca_status::Busy)));
+                assert_eq!(enter(owned, Access::End).err(), Some(mpca_status::Busy));
+                assert_eq!(mpca_world_destroy(owned), mpca_status::Busy);
+                leave(owned, Access::Read);
+                assert_eq!(mpca_world_destroy(owned), mpca_status::Ok);
+
+                // Caller memory: a claim holds the world in it, refusing its
+                // calls, until the claim is dropped (the init refused).
+                let mut memory = std::vec![0u8; bytes + 64];
+                let mut w = null_mut();
+                assert_eq!(mpca_world_init(&d, memory.as_mut_ptr().cast(), memory.len(), &mut w), mpca_status::Ok);
+                let claimed = claim(memory.as_mut_ptr().wrapping_add(32), 8).expect("no call inside");
+                assert_eq!(enter(w, Access::Read).err(), Some(mpca_status::Busy));
+                drop(claimed);
+                assert!(enter(w, Access::Read).is_ok());
+                leave(w, Access::Read);
+                assert_eq!(mpca_world_deinit(w), mpca_status::Ok);
+            }
+        }
 
         #[test]
         fn handle_values_of_distinct_numbers_differ_and_are_not_null() {
@@ -322,7 +457,7 @@ mod hosted {
 
 #[cfg(not(feature = "hosted"))]
 mod firmware {
-    use super::{mpca_status, mpca_world, World};
+    use super::{mpca_status, mpca_world, Access, World};
 
     /// Nothing to set aside: the handle is the world's address.
     pub(crate) struct Reserved;
@@ -331,13 +466,21 @@ mod firmware {
         Ok(Reserved)
     }
 
+    /// Nothing to hold: without a registry the library knows no world's
+    /// memory, and a firmware program calls from one thread.
+    pub(crate) struct Claim;
+
+    pub(crate) fn claim(_: *mut u8, _: usize) -> Result<Claim, mpca_status> {
+        Ok(Claim)
+    }
+
     /// The world's address, which its header's tag is tied to.
-    pub(crate) fn issue(_: Reserved, world: &mut World) -> *mut mpca_world {
+    pub(crate) fn issue(_: Reserved, _: Claim, world: &mut World) -> *mut mpca_world {
         world.as_ptr().cast()
     }
 
     /// The handle itself; its tag is checked by the caller.
-    pub(crate) fn resolve(handle: *const mpca_world) -> Result<*mut u8, mpca_status> {
+    pub(crate) fn enter(handle: *const mpca_world, _: Access) -> Result<*mut u8, mpca_status> {
         Ok(handle.cast_mut().cast())
     }
 

@@ -28,10 +28,13 @@
 //!   `catch_unwind` instead and returns `MPCA_STATUS_PANIC`, and the
 //!   program goes on without that world: the C tests build it so. Firmware
 //!   builds (no `hosted`) halt in a spin loop.
-//! - **Threads**: a world may move between threads but must not be used
-//!   from two at once, except for the tasks of a parallel step
-//!   (`parallel.rs`), during which the registry refuses every other call on
-//!   the world with `MPCA_STATUS_BUSY`.
+//! - **Threads** (hosted builds): a world may be used from any thread. The
+//!   registry lets calls that only read a world (`const mpca_world *`) in
+//!   together and a call that changes it (a step, parallel or not, an
+//!   edit, its end) in alone, once the reads inside returned, and refuses
+//!   any other call with `MPCA_STATUS_BUSY` at once; during a parallel step
+//!   only its tasks reach the world (`parallel.rs`). Firmware builds: one
+//!   call at a time.
 #![no_std]
 #![deny(missing_docs)]
 #![allow(non_camel_case_types)]

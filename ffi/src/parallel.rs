@@ -1,11 +1,10 @@
 //! The parallel step (M11): a step split into tasks that the host's own
 //! threads run. Hosted builds only: the registry of handles keeps the step's
-//! state, refuses every other call on the world while it runs, and hands
-//! out each task once.
+//! state, refuses every other call on the world while it runs (the step
+//! enters its world as every changing call does), and hands out each task
+//! once.
 
 use core::ffi::c_void;
-
-use mpca_core::World;
 
 use crate::{guard, handle, mpca_status, mpca_world};
 
@@ -25,11 +24,16 @@ pub type mpca_run_tasks = Option<unsafe extern "C" fn(world: *mut mpca_world, ti
 /// `user_data`. The world is the one mpca_world_step gives, bit for bit,
 /// whatever the task count, the order or the threads.
 ///
-/// What may run concurrently: while this call runs, only
-/// mpca_world_step_task may be called on this world, from any thread and
-/// concurrently for distinct tasks; any other call on it (this one
-/// included, from another thread or from inside a task) returns
-/// `MPCA_STATUS_BUSY` and changes nothing. Other worlds are unaffected.
+/// What may run concurrently (the rule at `mpca_world`): the step waits
+/// for the calls reading the world to return, refusing new ones, and
+/// returns `MPCA_STATUS_BUSY` at once, stepping nothing, when another
+/// changing call or a parallel step is inside. While it
+/// runs, only mpca_world_step_task may be called on this world, from any
+/// thread and concurrently for distinct tasks; any other call on it (this
+/// one included, from another thread or from inside a task; mpca_world_init
+/// or mpca_world_init_from_image over its memory too) returns
+/// `MPCA_STATUS_BUSY` and changes nothing. So a call on the world completes
+/// before the step begins, or is refused. Other worlds are unaffected.
 ///
 /// A task the host did not run is run on this thread before the step ends,
 /// so a `run_tasks` that returns early still completes the step. Hosted
@@ -42,24 +46,12 @@ pub unsafe extern "C" fn mpca_world_step_parallel(
     run_tasks: mpca_run_tasks,
     user_data: *mut c_void,
 ) -> mpca_status {
-    guard(|_| {
-        if world.is_null() {
-            return Err(mpca_status::NullPointer);
-        }
+    guard(|c| {
         let run_tasks = run_tasks.ok_or(mpca_status::NullPointer)?;
-        let at = handle::begin_step(world)?;
-        /// Ends the step however the call ends.
-        struct Release(*mut mpca_world);
-        impl Drop for Release {
-            fn drop(&mut self) {
-                handle::end_step(self.0);
-            }
-        }
-        let _release = Release(world);
-        // SAFETY: begin_step found `at` live in the registry (as Call::world
-        // does), and it now refuses every other call on this world, so this
-        // is the only reference until end_step.
-        let w = unsafe { World::from_ptr(at) }.map_err(|_| mpca_status::BadHandle)?;
+        // Entered for Write: refused with Busy while any other call is
+        // inside the world, and every call but the tasks' is refused until
+        // this one returns.
+        let w = c.world(world)?;
         for _ in 0..steps {
             w.step_parallel(max_tasks as usize, &mut |count, task| {
                 let ticket = handle::open_tasks(world, count, task);

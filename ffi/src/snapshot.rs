@@ -90,7 +90,7 @@ pub unsafe extern "C" fn mpca_world_save(world: *const mpca_world, buf: *mut c_v
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_world_load(world: *mut mpca_world, image: *const c_void, len: usize) -> mpca_status {
     guard(|c| {
-        let w = c.world(world)?;
+        let w = c.world_to_end(world)?;
         let (at, size) = span(w);
         if overlap(image.cast(), len, at, size) {
             return Err(mpca_status::Overlap);
@@ -137,9 +137,10 @@ pub unsafe extern "C" fn mpca_world_init_from_image(
         }
         let image = c.slice(image.cast::<u8>(), image_len, mpca_status::BadLength)?;
         let bytes = c.slice_mut(memory.cast::<u8>(), len, mpca_status::BadLength)?;
+        let claim = handle::claim(memory.cast(), len)?;
         let number = handle::reserve()?;
         let world = World::init_from_image(image, bytes)?;
-        out.set(handle::issue(number, world));
+        out.set(handle::issue(number, claim, world));
         Ok(())
     })
 }

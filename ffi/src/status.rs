@@ -29,8 +29,12 @@ pub enum mpca_status {
     OutputTooSmall = 6,
     /// The cell is not an obstacle surface cell.
     NotASurface = 7,
-    /// The world is inside mpca_world_step_parallel: only
-    /// mpca_world_step_task reaches it until that returns.
+    /// Another call is inside the world and this one cannot share it (the
+    /// rule at `mpca_world`): a parallel step (only mpca_world_step_task
+    /// reaches the world until it returns) or another call that changes
+    /// it; or, for a call that ends or replaces the world (deinit, destroy,
+    /// load, a world built over its memory), any call. Nothing was changed;
+    /// the call may be made again.
     Busy = 8,
     /// The ticket is not the parallel step in flight on this world (a task
     /// of an earlier step, or no step in flight).
@@ -40,7 +44,9 @@ pub enum mpca_status {
     /// This task of the step was run already.
     TaskDone = 11,
     /// Two memory ranges of the call overlap: an image and the memory of
-    /// the world it is saved from, loaded into or built in.
+    /// the world it is saved from, loaded into or built in; or the memory
+    /// handed to mpca_world_init or mpca_world_init_from_image and a world
+    /// mpca_world_create allocated (hosted builds).
     Overlap = 12,
     /// The dimension is neither 2 nor 3.
     BadDimension = 100,
@@ -209,11 +215,11 @@ impl mpca_status {
             S::BadStructSize => c"struct_size does not match this library's structure",
             S::BadEnum => c"an enumeration or flag field holds an unknown value",
             S::NotASurface => c"the cell is not an obstacle surface cell",
-            S::Busy => c"the world is in a parallel step; only its tasks may run until it returns",
+            S::Busy => c"another call is inside the world (a parallel step, or a call that changes it); nothing was done",
             S::StaleTask => c"the ticket is not the parallel step in flight on this world",
             S::TaskIndex => c"the task index is not below the step's task count",
             S::TaskDone => c"this task of the step was run already",
-            S::Overlap => c"an image overlaps the memory of the world it is saved from, loaded into or built in",
+            S::Overlap => c"an image overlaps the memory of its world, or new world memory lies in a world the library allocated",
             S::Unknown => c"an error this version of the C ABI does not name",
             // The statuses of core errors say what core says.
             S::BadHandle | S::OutputTooSmall | S::BadDimension | S::Dim3Disabled | S::SizeZero | S::SizeOdd | S::TooLarge | S::PeriodicMismatch | S::NotFinite | S::NegativeDt | S::BadVortex | S::BadDrag | S::RestitutionRange | S::MassRange | S::SpeedRange | S::Q16Disabled | S::FeatureDisabled | S::NotEnabled | S::CapacityRange | S::BufferTooSmall | S::OutOfBounds | S::CellOccupied | S::CellObstacle | S::NoParticle | S::MassTableFull | S::SurfaceTableFull | S::UndefinedNormal | S::EmitterTableFull | S::BadEmitter | S::LifetimeRange | S::BadShape | S::BadResolution | S::BadLength | S::NotOwned | S::OutOfMemory | S::NotAnImage | S::ImageVersion | S::ImageLength | S::ImageChecksum | S::ImageInvalid | S::ImageMismatch => match self.core_error() {

@@ -19,9 +19,28 @@ use crate::{check_size, guard, handle, mpca_desc, mpca_status};
 /// allocator or by a new world; the address of a world or of a copy of its
 /// bytes; any forged value. Building a world with mpca_world_init in memory
 /// that holds a live world ends that world: its handle is refused from then
-/// on. Where pointers are 32 bits wide the values run out after 2^32 - 1
+/// on (unless a call is inside it: see Threads). Where pointers are 32 bits wide the values run out after 2^32 - 1
 /// worlds in a process; create and init then return
 /// `MPCA_STATUS_OUT_OF_MEMORY`.
+///
+/// Threads (hosted builds): a world may be used from any thread, and calls
+/// on it from several threads at once never race: the registry decides
+/// who is inside. A call taking `const mpca_world *` only reads the world,
+/// and any number of those run together. A call taking `mpca_world *`
+/// changes it (mpca_world_step_parallel included) and runs alone: it waits
+/// for the reading calls inside to return (they wait for nothing, so the
+/// wait ends) while new calls are refused, and it returns
+/// `MPCA_STATUS_BUSY` at once, changing nothing, when another changing call
+/// or a parallel step is inside. Calls that end or replace a world do not
+/// wait: mpca_world_deinit, mpca_world_destroy, mpca_world_load, and
+/// mpca_world_init or mpca_world_init_from_image over its memory, return
+/// `MPCA_STATUS_BUSY` while any call is inside it (from any thread, or from
+/// a task of its step) and leave it alive; init in memory of a world
+/// mpca_world_create allocated returns `MPCA_STATUS_OVERLAP`. During a
+/// parallel step only its mpca_world_step_task calls reach the world. So a
+/// call on a world completes before a step or change begins, or begins
+/// after it ends, or is refused; a program that wants a refused call done
+/// makes it again.
 ///
 /// Firmware builds (without `hosted`: no allocator, no registry): the handle
 /// is the world's address in the caller's memory, and the world's header
@@ -38,7 +57,8 @@ use crate::{check_size, guard, handle, mpca_desc, mpca_status};
 /// which is undefined behaviour if it is gone (as for any dangling pointer);
 /// and once mpca_world_init builds a new world at the same address, the old
 /// handle equals the new one and reaches the new world. End a world with
-/// mpca_world_deinit and drop its handle before the memory is reused.
+/// mpca_world_deinit and drop its handle before the memory is reused. A
+/// firmware world is used by one call at a time.
 pub struct mpca_world {
     _opaque: [u8; 0],
 }
@@ -49,7 +69,9 @@ pub struct mpca_world {
 /// allocated. The world stays valid until mpca_world_deinit or until the
 /// memory is freed or reused; do not move or copy the memory meanwhile.
 /// A world built over a live one ends it (see `mpca_world` for what its
-/// handle then does).
+/// handle then does), unless a call is inside that one: then this returns
+/// `MPCA_STATUS_BUSY` and changes nothing (hosted builds; see Threads at
+/// `mpca_world`).
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_world_init(
     desc: *const mpca_desc,
@@ -63,9 +85,10 @@ pub unsafe extern "C" fn mpca_world_init(
         let d = d.as_ref().map_err(|&s| s)?;
         let out = c.out(out_world)?;
         let bytes = c.slice_mut(memory.cast::<u8>(), len, mpca_status::BadLength)?;
+        let claim = handle::claim(memory.cast(), len)?;
         let number = handle::reserve()?;
         let world = World::init(d, bytes)?;
-        out.set(handle::issue(number, world));
+        out.set(handle::issue(number, claim, world));
         Ok(())
     })
 }
@@ -76,7 +99,7 @@ pub unsafe extern "C" fn mpca_world_init(
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_world_deinit(world: *mut mpca_world) -> mpca_status {
     guard(|c| {
-        let w = c.world(world)?;
+        let w = c.world_to_end(world)?;
         if w.is_owned() {
             return Err(mpca_status::BadHandle);
         }
@@ -109,14 +132,14 @@ pub unsafe extern "C" fn mpca_world_create(desc: *const mpca_desc, out_world: *m
 #[cfg(feature = "hosted")]
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_world_destroy(world: *mut mpca_world) -> mpca_status {
-    guard(|_| {
+    guard(|c| {
         if world.is_null() {
             return Ok(());
         }
-        let at = handle::resolve(world)?;
-        // SAFETY: the registry holds `at` for a live handle (as in
-        // `Call::world`); from_raw checks the tag, and that the library
-        // allocated it.
+        let at = c.enter(world, handle::Access::End)?;
+        // SAFETY: the registry holds `at` for a live handle, entered for
+        // Write, so no other call is inside (as in `Call::world`); from_raw
+        // checks the tag, and that the library allocated it.
         let owned = unsafe { mpca_core::WorldBox::from_raw(at)? };
         handle::revoke(world);
         drop(owned);

@@ -11,7 +11,15 @@
  * - a world is rebuilt from its own export: every particle read back with
  *   mpca_world_cell is added again to a world of the same description,
  *   and the two hash equal (2D and 3D, 8- and 16-bit velocities, right
- *   after adding velocities of length 1 and after steps).
+ *   after adding velocities of length 1 and after steps);
+ * - speed limits at 1 and one unit in the last place beyond, in each
+ *   direction: a wind cell, a wind field, the description's wind and an
+ *   emitter take |u| <= 1 exactly, so (0.6, 0.8) and (1, 2e-4), over 1 by
+ *   about 2e-8, are refused with MPCA_STATUS_SPEED_RANGE and change
+ *   nothing; a particle takes what a world can store (each component in
+ *   [-1, 1], and the velocity rounded to its quanta within one quantum of
+ *   |v| <= 1: docs/model.md M1), so those two are accepted and only a
+ *   component beyond 1 is refused.
  */
 #include <math.h>
 #include <stdio.h>
@@ -234,10 +242,107 @@ static void rebuild_cases(void) {
     CHECK(above_total > 0);
 }
 
+/* --- Speed limits ----------------------------------------------------------- */
+
+/* One velocity against every speed check. `wind_ok`: the wind cell, wind
+ * field, description wind and emitter accept it; `particle_ok`: a particle
+ * may have it. Refusals must be SPEED_RANGE and change nothing. */
+static unsigned speed_cases;
+
+static void speed_case(uint32_t dim, float x, float y, float z, int wind_ok, int particle_ok) {
+    const float v[3] = {x, y, dim == 3 ? z : 0.0f};
+    const mpca_status want = wind_ok ? MPCA_STATUS_OK : MPCA_STATUS_SPEED_RANGE;
+    const uint32_t origin[3] = {0, 0, 0};
+    mpca_desc d;
+    mpca_world *w = NULL;
+    float field[3 * 8];
+    uint64_t before = 0, after = 0;
+    uint32_t index = 0;
+    mpca_emitter e;
+    unsigned k;
+    char what[160];
+    snprintf(what, sizeof what, "%uD (%.9g, %.9g, %.9g)", dim, (double)v[0], (double)v[1], (double)v[2]);
+
+    CHECK_OK(mpca_desc_defaults(&d, dim, 2, 2, 2));
+    d.forces = MPCA_FORCE_UNIFORM;
+    d.drag_rate = 0.1f;
+    d.drag_wind_field = 1;
+    d.emitter_capacity = 1;
+    for (k = 0; k < 3; k++) {
+        d.drag_wind[k] = v[k];
+    }
+    check_status(mpca_desc_validate(&d), want, what, __FILE__, __LINE__);
+    for (k = 0; k < 3; k++) {
+        d.drag_wind[k] = 0.0f;
+    }
+    if (mpca_world_create(&d, &w) != MPCA_STATUS_OK) {
+        CHECK(0);
+        return;
+    }
+    CHECK_OK(mpca_world_hash(w, &before));
+    check_status(mpca_world_set_cell_wind(w, origin, v), want, what, __FILE__, __LINE__);
+    memset(field, 0, sizeof field);
+    for (k = 0; k < dim; k++) {
+        field[dim * 3 + k] = v[k]; /* the fourth cell */
+    }
+    check_status(mpca_world_set_wind_field(w, field, dim == 3 ? 24 : 8), want, what, __FILE__, __LINE__);
+    memset(&e, 0, sizeof e);
+    e.struct_size = sizeof e;
+    e.max[0] = e.max[1] = e.max[2] = 1;
+    e.rate = 1.0f;
+    for (k = 0; k < 3; k++) {
+        e.velocity[k] = v[k];
+    }
+    e.mass = 1.0f;
+    check_status(mpca_world_add_emitter(w, &e, &index), want, what, __FILE__, __LINE__);
+    check_status(mpca_world_add_particle(w, origin, v), particle_ok ? MPCA_STATUS_OK : MPCA_STATUS_SPEED_RANGE, what,
+                 __FILE__, __LINE__);
+    if (!wind_ok && !particle_ok) {
+        CHECK_OK(mpca_world_hash(w, &after));
+        CHECK(after == before);
+    }
+    CHECK_OK(mpca_world_destroy(w));
+    speed_cases++;
+}
+
+static void speed_limits(void) {
+    const float one_up = nextafterf(1.0f, 2.0f), one_down = nextafterf(1.0f, 0.0f);
+    const float tiny = nextafterf(0.0f, 1.0f);
+    uint32_t dim;
+    check_context = "speed limits";
+    for (dim = 2; dim <= 3; dim++) {
+        float z = dim == 3 ? 1.0f : 0.0f;
+        /* Along each axis: 1 passes, one unit more fails, one less passes. */
+        speed_case(dim, 1.0f, 0.0f, 0.0f, 1, 1);
+        speed_case(dim, 0.0f, -1.0f, 0.0f, 1, 1);
+        speed_case(dim, one_up, 0.0f, 0.0f, 0, 0);
+        speed_case(dim, 0.0f, -one_up, 0.0f, 0, 0);
+        speed_case(dim, one_down, 0.0f, 0.0f, 1, 1);
+        /* The least excess: a unit component and a subnormal one. */
+        speed_case(dim, 1.0f, tiny, 0.0f, 0, 1);
+        speed_case(dim, one_down, tiny, 0.0f, 1, 1);
+        /* The cases, and one unit less of either component. */
+        speed_case(dim, 0.6f, 0.8f, 0.0f, 0, 1);
+        speed_case(dim, -0.8f, 0.6f, 0.0f, 0, 1);
+        speed_case(dim, 1.0f, 2e-4f, 0.0f, 0, 1);
+        speed_case(dim, 0.6f, nextafterf(0.8f, 0.0f), 0.0f, 1, 1);
+        speed_case(dim, nextafterf(0.6f, 0.0f), 0.8f, 0.0f, 1, 1);
+        if (dim == 3) {
+            speed_case(dim, 0.0f, 0.0f, z, 1, 1);
+            speed_case(dim, 0.0f, 0.0f, -one_up, 0, 0);
+            speed_case(dim, 0.6f, 0.0f, -0.8f, 0, 1);
+            speed_case(dim, tiny, 0.0f, one_down, 1, 1);
+            speed_case(dim, tiny, 0.0f, 1.0f, 0, 1);
+        }
+    }
+    printf("speed limits: %u velocities, each against 5 checks\n", speed_cases);
+}
+
 int main(void) {
     check_begin();
     half_space_in_2d();
     vortex_cases();
     rebuild_cases();
+    speed_limits();
     return check_end();
 }

@@ -23,10 +23,19 @@
 //! - `header_only.c`: `include/mpca.h` alone, as C99 and as C++11.
 //! - `cpp_wrapper.cpp` (linked statically): `include/mpca.hpp`, the C++11
 //!   wrapper, against the C functions it wraps.
+//! - `parallel.c` (linked statically): the parallel step from C (M11).
+//! - `threads.c` (linked statically): calls on one world from several
+//!   threads, and worlds built, loaded or ended over a world in use.
 //!
 //! With `MPCA_C_SANITIZE=1` every program is built with AddressSanitizer
 //! (LeakSanitizer included) and UndefinedBehaviorSanitizer, into a separate
 //! directory, and the tests check that the sanitizer is really linked in.
+//! `parallel.c` and `threads.c` also run built with ThreadSanitizer in
+//! every run, against the plain library (the sanitizer then sees the C
+//! side only); with `MPCA_C_SANITIZE=thread` against a library built with
+//! ThreadSanitizer inside (`clib::tsan_library`, nightly Rust), so that the
+//! library's own reads and writes are checked too. `.ci/run` runs the
+//! `thread_sanitizer` tests so.
 //! ELF inspection and the link flags assume Linux.
 #![cfg(target_os = "linux")]
 
@@ -52,6 +61,11 @@ const SANITIZE_FLAGS: [&str; 3] = ["-fsanitize=address,undefined", "-fno-omit-fr
 
 fn sanitize() -> bool {
     std::env::var("MPCA_C_SANITIZE").is_ok_and(|v| v == "1")
+}
+
+/// Whether the ThreadSanitizer tests link the library built with it inside.
+fn tsan_inside() -> bool {
+    std::env::var("MPCA_C_SANITIZE").is_ok_and(|v| v == "thread")
 }
 
 /// Where the C programs go; sanitized builds apart from plain ones.
@@ -268,6 +282,11 @@ fn edges() -> &'static Run {
 fn parallel() -> &'static Run {
     static RUN: OnceLock<Run> = OnceLock::new();
     RUN.get_or_init(|| run(build("parallel", &["parallel.c", "check.c"], Link::Static), ""))
+}
+
+fn threads() -> &'static Run {
+    static RUN: OnceLock<Run> = OnceLock::new();
+    RUN.get_or_init(|| run(build("threads", &["threads.c", "check.c"], Link::Static), ""))
 }
 
 /// `panic.c` with the library built with catch-panics (static), and with
@@ -764,7 +783,7 @@ fn exports_from_c_agree_with_the_cells_and_the_density() {
 
 #[test]
 fn sanitizers_are_linked_in_exactly_when_asked() {
-    for run in [errors(), scenes(), reuse(), edges(), parallel(), snapshots(), cpp_wrapper()] {
+    for run in [errors(), scenes(), reuse(), edges(), parallel(), threads(), snapshots(), cpp_wrapper()] {
         let printed = run.value("sanitizer: ");
         let needed = Elf::read(&run.exe).needed();
         let asan = needed.iter().any(|n| n.starts_with("libasan.so"));
@@ -850,6 +869,19 @@ fn a_world_rebuilds_from_its_own_export() {
         assert!(line.contains(" 0 refused"), "{line}");
     }
     run.assert_no_failures_in("a world rebuilt from its own export");
+}
+
+/// Every speed limit at 1 and one unit in the last place beyond it, in
+/// each direction, 2D and 3D: the wind cell, the wind field, the
+/// description's wind and an emitter refuse (0.6, 0.8), (1, 2e-4) and a
+/// unit component beside a subnormal one (all over 1, though their squares
+/// summed in f32 round to 1), changing nothing; a particle takes what a
+/// world can store, so only a component beyond 1 is refused.
+#[test]
+fn speed_limits_from_c_are_exact() {
+    let run = edges();
+    assert_eq!(run.value("speed limits: "), "29 velocities, each against 5 checks");
+    run.assert_no_failures_in("speed limits");
 }
 
 /// The README's C example (its first ```c block), compiled with the same
@@ -1004,23 +1036,51 @@ fn parallel_step_misuse_from_c_is_refused() {
 /// `parallel.c` built with ThreadSanitizer (the host's threads, the
 /// calls of mpca_world_step_task from two threads at once, the other
 /// thread's refused call) runs clean: no race reported, every check
-/// passed. The library itself is not instrumented (Rust needs a nightly
-/// rebuild of std for that); its tasks touch disjoint memory by
-/// construction (core/src/storage/cells.rs). Skipped in the AddressSanitizer run,
-/// which cannot be combined with it.
+/// passed. Its tasks touch disjoint memory by construction
+/// (core/src/storage/cells.rs). With `MPCA_C_SANITIZE=thread` the library is
+/// instrumented too. Skipped in the AddressSanitizer run, which cannot be
+/// combined with it.
 #[test]
 fn parallel_steps_from_c_run_clean_under_thread_sanitizer() {
+    run_under_thread_sanitizer("parallel");
+}
+
+/// `threads.c` built with ThreadSanitizer runs clean: readers beside
+/// steps, worlds built, loaded and ended over worlds in use, from tasks and
+/// other threads. Against the instrumented library (`MPCA_C_SANITIZE=thread`)
+/// this is the test of the rule at `mpca_world`: before the registry knew
+/// who was inside a world, it reported the step's writes against the
+/// reads of stats and hash, and a world built over a stepping one.
+#[test]
+fn threads_from_c_run_clean_under_thread_sanitizer() {
+    run_under_thread_sanitizer("threads");
+}
+
+/// Builds `tests/c/<name>.c` with ThreadSanitizer, runs it, and checks
+/// that no race was reported and every check passed; with
+/// `MPCA_C_SANITIZE=thread` against the library built with it inside,
+/// which is checked to hold the sanitizer's calls.
+fn run_under_thread_sanitizer(name: &str) {
     if sanitize() {
-        println!("parallel-tsan: skipped in the AddressSanitizer run");
+        println!("{name}-tsan: skipped in the AddressSanitizer run");
         return;
     }
-    let exe = out_dir().join("parallel-tsan");
+    let inside = tsan_inside();
+    let lib = if inside { clib::tsan_library() } else { library() };
+    let archive = std::fs::read(lib.join("libmpca.a")).expect("libmpca.a");
+    let instrumented = archive.windows(b"__tsan_func_entry".len()).any(|w| w == b"__tsan_func_entry");
+    assert_eq!(instrumented, inside, "{}: ThreadSanitizer's calls in libmpca.a", lib.display());
+    let exe = out_dir().join(format!("{name}-tsan{}", if inside { "-inside" } else { "" }));
     let mut cmd = compiler(false, true);
     cmd.arg("-fsanitize=thread").arg("-o").arg(&exe);
-    for s in ["parallel.c", "check.c"] {
+    let mut sources = vec![format!("{name}.c"), "check.c".to_string()];
+    if inside {
+        sources.push("tsan_memory.c".to_string());
+    }
+    for s in &sources {
         cmd.arg(root().join("tests/c").join(s));
     }
-    cmd.arg(library().join("libmpca.a")).args(["-lm", "-lpthread", "-ldl"]);
+    cmd.arg(lib.join("libmpca.a")).args(["-lm", "-lpthread", "-ldl"]);
     let out = cmd.output().expect("the C compiler runs");
     assert!(out.status.success(), "ThreadSanitizer build failed:\n{}\n{}", command_line(&cmd), String::from_utf8_lossy(&out.stderr));
     let out = Command::new(&exe)
@@ -1030,9 +1090,62 @@ fn parallel_steps_from_c_run_clean_under_thread_sanitizer() {
         .expect("the program runs");
     let stdout = String::from_utf8_lossy(&out.stdout);
     let stderr = String::from_utf8_lossy(&out.stderr);
+    // Printed so that .ci/run's log shows which library was checked.
+    println!("{name}-tsan: libmpca {}; {}", if inside { "instrumented with ThreadSanitizer" } else { "not instrumented" }, tail(&stdout, 1));
+    for line in stdout.lines().filter(|l| l.starts_with(name)) {
+        println!("{name}-tsan: {line}");
+    }
     assert!(!stderr.contains("ThreadSanitizer"), "{}", tail(&stderr, 60));
     assert!(out.status.success(), "exit {}: {}\n{}", out.status, tail(&stdout, 20), tail(&stderr, 20));
     assert!(stdout.contains("checks: ") && stdout.contains("failed: 0"), "{}", tail(&stdout, 20));
+}
+
+// --- Threads -------------------------------------------------------------------
+
+/// One thread reads stats and hash while another steps, in parallel and
+/// serially, 1,200 steps: every step succeeds (it waits for the reads),
+/// reads are OK or BUSY, and every reading taken between two equal step
+/// counts hashes as the world did at that step: no read saw a world half
+/// stepped (before the registry knew who was inside, readings at hashes
+/// of no step were seen).
+#[test]
+fn readers_beside_steps_see_whole_steps() {
+    let run = threads();
+    let line = run.value("threads: readers and steps: ");
+    assert!(line.starts_with("1200 steps (0 refused BUSY)"), "{line}");
+    assert!(line.contains("all at a step's hash: yes"), "{line}");
+    run.assert_no_failures_in("readers and steps");
+}
+
+/// Inside a parallel step's run_tasks, and from a thread it starts:
+/// mpca_world_init and _init_from_image over the stepped world's memory
+/// (whole, and overlapping), mpca_world_load, _deinit, _destroy (of a world
+/// itself in a step) and a second step are each refused with BUSY, write
+/// no handle, and the step ends as the serial one.
+#[test]
+fn worlds_in_use_are_not_built_over_loaded_or_ended() {
+    let run = threads();
+    let lines = run.values("threads: memory in use, from ");
+    assert_eq!(lines, ["the task's host: 8 calls refused BUSY", "another thread: 8 calls refused BUSY"], "{}", run.stdout);
+    run.assert_no_failures_in("memory in use");
+}
+
+/// A thread steps or reads a world until its handle dies while the main
+/// thread builds a world over its memory, deinitialises or destroys it,
+/// retrying on BUSY: 40 rounds each. The user's calls end with BAD_HANDLE,
+/// never anything else, and no world built over the memory was stepped by
+/// the old handle (it was, 3 or 15 steps, when init ignored what was
+/// inside).
+#[test]
+fn worlds_end_only_when_no_call_is_inside() {
+    let run = threads();
+    let lines = run.values("threads: ending a world in use by ");
+    assert_eq!(lines.len(), 3, "{}", run.stdout);
+    for line in &lines {
+        assert!(line.ends_with("new worlds stepped: 0"), "{line}");
+    }
+    run.assert_no_failures_in("ending a world in use");
+    run.assert_success();
 }
 
 // --- Snapshots (M12) and region counters ------------------------------------

@@ -3,7 +3,7 @@
 
 use crate::Error;
 use crate::rules::assign::Method;
-use crate::api::checks::{finite, mass, restitution, slow};
+use crate::api::checks::{finite, mass, restitution};
 
 /// What happens at one face of the domain (M4).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -271,7 +271,7 @@ impl Description {
         if self.drag.rate < 0.0 {
             return Err(Error::BadDrag);
         }
-        if !slow(self.drag.wind[..dim].iter().copied()) {
+        if !crate::api::speed::slow(&self.drag.wind[..dim]) {
             return Err(Error::SpeedRange);
         }
         if self.drag.vortex && self.drag.rate > 0.0 && self.vortex.core_radius <= 0.0 {

@@ -4,7 +4,8 @@
 //! written.
 
 use crate::Error;
-use crate::api::checks::{finite, slow};
+use crate::api::checks::finite;
+use crate::api::speed::slow;
 use crate::api::desc::{Boundary, Vortex};
 use crate::storage::layout::Planes;
 use crate::storage::world::World;
@@ -77,7 +78,7 @@ impl World {
         }
         finite(&v)?;
         let d = self.dim();
-        if velocity && !slow(v[..d].iter().copied()) {
+        if velocity && !slow(&v[..d]) {
             return Err(Error::SpeedRange);
         }
         plane(self.planes::<u8>().1)[s.cell * d..s.cell * d + d].copy_from_slice(&v[..d]);
@@ -110,7 +111,7 @@ impl World {
     pub fn set_wind_field(&mut self, wind: &[f32]) -> Result<(), Error> {
         let d = self.dim();
         self.force_plane_check(self.head.desc.drag.field, wind, d)?;
-        if wind.chunks_exact(d).any(|u| !slow(u.iter().copied())) {
+        if wind.chunks_exact(d).any(|u| !slow(u)) {
             return Err(Error::SpeedRange);
         }
         self.planes::<u8>().1.wind.copy_from_slice(wind);

@@ -13,3 +13,4 @@ pub(crate) mod obstacles;
 pub(crate) mod owned;
 pub(crate) mod query;
 pub(crate) mod snapshot;
+pub(crate) mod speed;

@@ -564,7 +564,8 @@ fn check(img: &Image<'_>) -> Result<(), Error> {
     if !floats(img.field) || !floats(img.potential) || !floats(img.wind) {
         return bad;
     }
-    if !(0..img.wind.len() / 4).step_by(dim).all(|i| crate::api::checks::slow((i..i + dim).map(|k| float(img.wind, k)))) {
+    let wind_cell = |i: usize| -> [f32; 3] { core::array::from_fn(|k| if k < dim { float(img.wind, i + k) } else { 0.0 }) };
+    if !(0..img.wind.len() / 4).step_by(dim).all(|i| crate::api::speed::slow(&wind_cell(i)[..dim])) {
         return bad;
     }
 

@@ -59,7 +59,7 @@ pub(crate) fn checked(e: &mut Emitter, dim: usize, n: [usize; 3], lifetimes: boo
     if e.rate < 0.0 || e.spread < 0.0 || (0..3).any(|k| e.min[k] >= e.max[k] || e.max[k] as usize > n[k]) {
         return Err(Error::BadEmitter);
     }
-    if too_fast(e.velocity, e.spread) {
+    if crate::api::speed::too_fast(e.velocity, e.spread) {
         return Err(Error::SpeedRange);
     }
     if e.lifetime > u32::from(u16::MAX) {
@@ -70,94 +70,6 @@ pub(crate) fn checked(e: &mut Emitter, dim: usize, n: [usize; 3], lifetimes: boo
     }
     Ok(())
 }
-
-/// Whether `|v| + spread > 1`, decided exactly, for finite `v` and
-/// `spread >= 0` (M6). In `f32` the sum would round 0.5 + 0.50000006 down
-/// to 1; in `f64`, as this was checked before, it still rounds a sum above
-/// 1 by less than about 1e-16 down to 1 (`[1, 2^-149, 0]` passed), and it
-/// cost a firmware double-precision soft float. Integers
-/// decide it instead, without error:
-///
-/// - `spread >= 1`: over 1 exactly when `spread > 1` or `v != 0`;
-/// - a component over 1 in size: over 1;
-/// - otherwise `spread < 1`, and `|v| + spread > 1` exactly when
-///   `|v|^2 > (1 - spread)^2` (both sides of `|v| > 1 - spread` are not
-///   negative), that is `|v|^2 + 2 spread > 1 + spread^2`. Every `f32` is
-///   an integer multiple of 2^-149, so every term here is one of 2^-298;
-///   components and spread are at most 1, so each side is below 5: in
-///   units of 2^-298 both are integers below 2^301, which [`Wide`] adds
-///   without loss and compares exactly.
-fn too_fast(v: [f32; 3], spread: f32) -> bool {
-    if spread >= 1.0 {
-        return spread > 1.0 || v.iter().any(|&c| c != 0.0);
-    }
-    if v.iter().any(|c| c.abs() > 1.0) {
-        return true;
-    }
-    let (mut left, mut right) = (Wide::default(), Wide::default());
-    for &c in &v {
-        left.add_square(c);
-    }
-    let (m, e) = parts(spread);
-    left.add(m, e + 1);
-    right.add(1, 0);
-    right.add_square(spread);
-    left.above(&right)
-}
-
-/// `x = m 2^e` (m below 2^24, e from -149 up) for a finite `x`, its sign
-/// dropped.
-fn parts(x: f32) -> (u64, i32) {
-    let bits = x.to_bits() & 0x7fff_ffff;
-    let (exponent, fraction) = ((bits >> 23) as i32, u64::from(bits & 0x7f_ffff));
-    if exponent == 0 {
-        (fraction, -149) // subnormal
-    } else {
-        (fraction | 1 << 23, exponent - 150)
-    }
-}
-
-/// A number below 2^301 in units of 2^-298 (every `f32` square is a whole
-/// number of them), in little-endian 32-bit limbs; see [`too_fast`].
-///
-/// Aligned to 8 bytes: its zeroing is then the library's one aligned
-/// clear (`__aeabi_memclr8` on Arm), not a copy of its own for 4 bytes.
-#[derive(Default)]
-#[repr(align(8))]
-struct Wide([u32; 10]);
-
-impl Wide {
-    /// Adds `m 2^e`, `m` below 2^48 and `e` from -298 up; the sums
-    /// [`too_fast`] makes stay below 2^301 units.
-    fn add(&mut self, m: u64, e: i32) {
-        let at = (e + 298) as u32;
-        // In pieces of 32 bits, each shifted by less than a limb, so a
-        // piece and its carries fit a u64.
-        for (piece, at) in [(m as u32, at), ((m >> 32) as u32, at + 32)] {
-            let mut carry = u64::from(piece) << (at % 32);
-            for limb in self.0.iter_mut().skip((at / 32) as usize) {
-                if carry == 0 {
-                    break;
-                }
-                let sum = u64::from(*limb) + carry;
-                *limb = sum as u32;
-                carry = sum >> 32;
-            }
-        }
-    }
-
-    /// Adds `x^2`.
-    fn add_square(&mut self, x: f32) {
-        let (m, e) = parts(x);
-        self.add(m * m, 2 * e);
-    }
-
-    /// Whether `self > other`.
-    fn above(&self, other: &Wide) -> bool {
-        self.0.iter().rev().cmp(other.0.iter().rev()) == core::cmp::Ordering::Greater
-    }
-}
-
 
 /// `floor(x)` for an `x` that is not negative (a rate: `checked`), by
 /// clearing the bits of its fraction: a few instructions where `floorf`
@@ -204,21 +116,6 @@ mod tests {
     use super::*;
     use crate::rules::rng::block_stream;
 
-    /// The check this replaced: `f64` throughout, exact but for the last
-    /// roundings.
-    fn in_f64(v: [f32; 3], spread: f32) -> (bool, f64) {
-        let speed = v.iter().map(|&c| f64::from(c) * f64::from(c)).sum::<f64>().sqrt();
-        (speed + f64::from(spread) > 1.0, speed + f64::from(spread))
-    }
-
-    fn up(x: f32) -> f32 {
-        f32::from_bits(x.to_bits() + 1)
-    }
-
-    fn down(x: f32) -> f32 {
-        f32::from_bits(x.to_bits() - 1)
-    }
-
     #[test]
     fn floor_rate_is_floor_for_rates() {
         // Expect: floorf's value, bit for bit, for 0, -0, every power of
@@ -238,108 +135,5 @@ mod tests {
         for _ in 0..crate::sized(100_000, 1_000) {
             check(f32::from_bits(rng.bits(31)));
         }
-    }
-
-    #[test]
-    fn speed_and_spread_of_exactly_one_pass_and_one_unit_more_fails() {
-        // Expect: |v| + spread exactly 1 passes, in 1, 2 and 3 components
-        // (3-4-5 and 1-2-2 triangles scaled by powers of 2, so exact in
-        // f32), and the next f32 up of the spread or of a component fails;
-        // as does the least possible excess, a subnormal spread on a unit
-        // speed, or a subnormal component beside a unit one (2^-298 over
-        // 1 in the square), which the f64 check took for 1. Spread 1 or
-        // more passes only with no speed, and over 1 never. 0.6 + 0.4 in
-        // f32 is over 1.
-        let tiny = f32::from_bits(1);
-        let exact: [([f32; 3], f32); 8] = [
-            ([0.5, 0.0, 0.0], 0.5),
-            ([0.0, 0.75, 0.0], 0.25),
-            ([0.375, -0.5, 0.0], 0.375),
-            ([0.25, 0.5, -0.5], 0.25),
-            ([1.0, 0.0, 0.0], 0.0),
-            ([0.0, -1.0, 0.0], 0.0),
-            ([0.0, 0.0, 0.0], 1.0),
-            ([0.0, 0.0, 1.0], -0.0),
-        ];
-        for (v, spread) in exact {
-            assert!(!too_fast(v, spread), "{v:?} {spread}");
-            assert!(too_fast(v, if spread == 0.0 { tiny } else { up(spread) }), "{v:?} {spread}");
-            for k in 0..3 {
-                let mut w = v;
-                w[k] = if w[k] == 0.0 { tiny } else { w[k].signum() * up(w[k].abs()) };
-                assert!(too_fast(w, spread), "{w:?} {spread}");
-            }
-        }
-        assert!(too_fast([1.0, tiny, 0.0], 0.0));
-        assert!(!in_f64([1.0, tiny, 0.0], 0.0).0, "the f64 check rounded it to 1");
-        assert!(!too_fast([down(1.0), 0.0, 0.0], tiny));
-        assert!(!too_fast([tiny, tiny, tiny], down(1.0)));
-        assert!(too_fast([0.0, 0.0, 0.0], up(1.0)));
-        assert!(too_fast([f32::MAX, 0.0, 0.0], 0.0));
-        assert!(too_fast([0.0, -f32::MAX, 0.0], f32::MAX));
-        assert!(too_fast([0.8, 0.7, 0.0], 0.0));
-        assert!(too_fast([0.6, 0.0, 0.0], 0.4), "0.6 and 0.4 as f32 sum to 1 + 3e-8");
-        assert!(in_f64([0.6, 0.0, 0.0], 0.4).0);
-        assert!(!too_fast([0.0, 0.6, 0.0], 0.2), "the smoke scenes' emitter");
-    }
-
-    /// `|v|^2 > (1 - spread)^2` in u128 units of 2^-108, for `v` and
-    /// `spread < 1` whose last bits are 2^-54 or more (else None): another
-    /// way to the exact answer, for a narrower range.
-    fn in_u128(v: [f32; 3], spread: f32) -> Option<bool> {
-        let fixed = |x: f32| {
-            let (m, e) = parts(x);
-            (e >= -54).then(|| u128::from(m) << (e + 54))
-        };
-        if spread >= 1.0 {
-            return None;
-        }
-        let mut square = 0;
-        for &c in &v {
-            square += fixed(c)?.pow(2);
-        }
-        Some(square > ((1u128 << 54) - fixed(spread)?).pow(2))
-    }
-
-    #[test]
-    fn speed_check_agrees_with_f64_wherever_that_is_not_within_its_rounding() {
-        // Expect: on 400,000 random emitters near the limit (a random
-        // velocity of up to 3 components with exponents from -1 to -30,
-        // and a spread from a few units below 1 - |v| to a few above), the
-        // exact check gives the f64 check's answer wherever the f64 sum is
-        // further than 2^-45 from 1 (its error is about 2^-52), and the
-        // answer of a u128 computation wherever every value's last bit is
-        // 2^-54 or more; some land on each side.
-        let mut rng = block_stream(12, 0, 0);
-        let (mut over, mut under, mut in_range) = (0, 0, 0);
-        for _ in 0..crate::sized(400_000, 200) {
-            let mut v = [0.0f32; 3];
-            for c in v.iter_mut().take(1 + rng.below(3) as usize) {
-                let scale = f32::from_bits((126 - rng.below(30)) << 23);
-                *c = (rng.unit() * 2.0 - 1.0) * scale;
-            }
-            let speed = v.iter().map(|&c| f64::from(c) * f64::from(c)).sum::<f64>().sqrt();
-            if speed >= 1.0 {
-                continue;
-            }
-            let mut spread = (1.0 - speed) as f32;
-            for _ in 0..rng.below(8) {
-                spread = up(spread);
-            }
-            for _ in 0..rng.below(8) {
-                spread = if spread > 0.0 { down(spread) } else { spread };
-            }
-            let (f64_says, sum) = in_f64(v, spread);
-            let says = too_fast(v, spread);
-            if (sum - 1.0).abs() > 2f64.powi(-45) {
-                assert_eq!(says, f64_says, "{v:?} {spread}");
-            }
-            if let Some(exact) = in_u128(v, spread) {
-                assert_eq!(says, exact, "{v:?} {spread}");
-                in_range += 1;
-            }
-            if says { over += 1 } else { under += 1 }
-        }
-        assert!(over > 0 && under > 0 && in_range > 0, "{over} {under} {in_range}");
     }
 }

@@ -159,6 +159,18 @@ impl World {
     /// `'a`. A retired world, or memory that never held one, is refused by its
     /// tag.
     pub unsafe fn from_ptr<'a>(ptr: *mut u8) -> Result<&'a mut World, Error> {
+        // SAFETY: the caller's promise, passed on.
+        Ok(unsafe { &mut *Self::from_ptr_raw(ptr)? })
+    }
+
+    /// [`World::from_ptr`] without forming a reference: the caller decides
+    /// whether to read only (a shared reference, where other calls may read
+    /// the world at the same time, as mpca-ffi lets them) or to write.
+    ///
+    /// # Safety
+    /// As for [`World::from_ptr`], for the header's check; what the caller
+    /// then does through the pointer is its own to justify.
+    pub unsafe fn from_ptr_raw(ptr: *mut u8) -> Result<*mut World, Error> {
         if ptr.is_null() || (ptr as usize) % WORLD_ALIGN != 0 {
             return Err(Error::NotAWorld);
         }
@@ -170,8 +182,8 @@ impl World {
         if tag != TAG ^ ptr as u64 {
             return Err(Error::NotAWorld);
         }
-        // SAFETY: the tag says a world was built here with `len` plane bytes.
-        Ok(unsafe { &mut *(core::ptr::slice_from_raw_parts_mut(ptr, len) as *mut World) })
+        // The tag says a world was built here with `len` plane bytes.
+        Ok(core::ptr::slice_from_raw_parts_mut(ptr, len) as *mut World)
     }
 
     /// The address [`World::from_ptr`] takes back.

@@ -36,6 +36,37 @@ pub fn catching_library() -> &'static Path {
     DIR.get_or_init(|| build_library("c-test-unwind", "panic-test,catch-panics"))
 }
 
+/// The shipped library (as [`library`]) with ThreadSanitizer compiled in,
+/// for the C tests of threads under `MPCA_C_SANITIZE=thread`: built by
+/// nightly Rust (`-Zsanitizer=thread`, with `core` and `alloc` rebuilt by
+/// `-Zbuild-std` so that their code is instrumented too), so the sanitizer
+/// sees the library's own reads and writes, not only the C program's.
+/// Needs the nightly toolchain with `rust-src`, as `.ci/run` installs.
+pub fn tsan_library() -> &'static Path {
+    static DIR: OnceLock<PathBuf> = OnceLock::new();
+    DIR.get_or_init(|| {
+        let target_dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("ffi-tsan");
+        let triple = env!("MPCA_TEST_HOST");
+        let mut cargo = Command::new("cargo");
+        // The outer cargo's settings are for the stable build.
+        for var in ["RUSTFLAGS", "CARGO_ENCODED_RUSTFLAGS", "RUSTC", "RUSTC_WRAPPER", "RUSTDOC", "RUSTUP_TOOLCHAIN", "CARGO_BUILD_TARGET"] {
+            cargo.env_remove(var);
+        }
+        let out = cargo
+            .current_dir(root())
+            .env("RUSTFLAGS", "-Zsanitizer=thread")
+            .args(["+nightly", "build", "-Zbuild-std=core,alloc", "--target", triple, "--profile", "c-test", "-p", "mpca-ffi"])
+            .args(["--features", "panic-test", "--target-dir"])
+            .arg(&target_dir)
+            .output()
+            .expect("cargo +nightly runs");
+        assert!(out.status.success(), "building libmpca with ThreadSanitizer failed:\n{}", String::from_utf8_lossy(&out.stderr));
+        let dir = target_dir.join(triple).join("c-test");
+        assert!(dir.join("libmpca.a").is_file(), "libmpca.a missing from {}", dir.display());
+        dir
+    })
+}
+
 fn build_library(profile: &str, features: &str) -> PathBuf {
     let target_dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("ffi");
     let cargo = std::env::var_os("CARGO").unwrap_or_else(|| env!("CARGO").into());
