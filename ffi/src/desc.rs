@@ -233,7 +233,7 @@ impl mpca_desc {
         // The flags, and the enumerations of two values, are converted as
         // read, and all checked at the end at once: valid when none is
         // above 1, that is when they or'ed together are at most 1 (a test
-        // and a branch of its own for each was some 20 bytes a field on a
+        // and a branch of its own for each cost flash for every field on a
         // small core). `d` is a local: what a refusal leaves in it is
         // dropped.
         let mut ones = 0;

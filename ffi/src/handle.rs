@@ -120,8 +120,7 @@ mod hosted {
     /// Live worlds, sorted by handle value, found by binary search. A
     /// program holds a few worlds, rarely thousands, so moving the ones
     /// after an inserted or removed entry costs nothing that shows beside
-    /// building a world; a BTreeMap's code made libmpca.so 13 KB larger
-    /// (395,472 against 382,120 bytes stripped).
+    /// building a world; a BTreeMap's code made libmpca.so larger for it.
     struct Live(Vec<(usize, Entry)>);
 
     impl Live {
@@ -268,8 +267,8 @@ mod hosted {
     /// inside (or waiting to be), or, for a call that ends the world, any
     /// call is. A changing call finding reading calls inside waits for them.
     // Not inlined: every export calls it, and the lock and the map search
-    // inlined into each made libmpca.so 8.5 KB larger (403,864 against
-    // 395,360 bytes stripped); the call costs a few instructions a call.
+    // inlined into each made libmpca.so much larger; the call costs a few
+    // instructions a call.
     #[inline(never)]
     pub(crate) fn enter(handle: *const mpca_world, access: Access) -> Result<*mut u8, mpca_status> {
         {

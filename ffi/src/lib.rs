@@ -20,10 +20,9 @@
 //!   on stderr (`mpca: panicked at FILE:LINE:COLUMN: MESSAGE`) and calls
 //!   `abort()`; it is built with `panic = "abort"` (the workspace's
 //!   profiles set it) and without Rust's `std`, whose panic machinery
-//!   (hook, backtraces, DWARF reader, demangler) would be 43 % of the
-//!   stripped shared library (x86-64 Linux: 670 KB with `std`, 382 KB
-//!   without) and would need `libgcc_s` at run time, for a world the panic
-//!   may have left half stepped anyway (`sys.rs`). With the feature `catch-panics` (which links
+//!   (hook, backtraces, DWARF reader, demangler) would be a large part of
+//!   the stripped shared library and would need `libgcc_s` at run time,
+//!   for a world the panic may have left half stepped anyway (`sys.rs`). With the feature `catch-panics` (which links
 //!   `std`; build it with `panic = "unwind"`) every export runs inside
 //!   `catch_unwind` instead and returns `MPCA_STATUS_PANIC`, and the
 //!   program goes on without that world: the C tests build it so. Firmware

@@ -6,9 +6,8 @@
 //! shows `libc.so.6` as its one dependency).
 //!
 //! Why not `std`: linking it brings its panic machinery (the default hook,
-//! backtraces, symbol demangling, DWARF parsing): 288 KB of the stripped
-//! shared library on x86-64 Linux (669,760 bytes with `std` and panic =
-//! "abort", 382,120 without), for a panic that is a bug and should end the
+//! backtraces, symbol demangling, DWARF parsing), a large part of the
+//! stripped shared library, for a panic that is a bug and should end the
 //! program anyway; and it needs GCC's unwinder, `libgcc_s`, at run time.
 //! The feature `catch-panics` builds with `std` and its panic boundary
 //! instead (lib.rs).

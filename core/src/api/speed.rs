@@ -49,7 +49,7 @@ fn far_from_one(v: &[f32; 3]) -> Option<bool> {
 /// `spread >= 0` (M6). In `f32` the sum would round 0.5 + 0.50000006 down
 /// to 1; in `f64`, as this was checked before, it still rounds a sum above
 /// 1 by less than about 1e-16 down to 1 (`[1, 2^-149, 0]` passed), and it
-/// cost a firmware over 2 KB of double-precision soft float. Integers
+/// cost a firmware double-precision soft float. Integers
 /// decide it instead, without error:
 ///
 /// - `spread >= 1`: over 1 exactly when `spread > 1` or `v != 0`;
