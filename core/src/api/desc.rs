@@ -303,8 +303,8 @@ impl Description {
     }
 
     /// `per_particle_mass`, false by construction in a build without the
-    /// feature `mass` ([`Description::check`] refuses it there): the step and the
-    /// edits test this, so such a build holds no code for masses.
+    /// feature `mass` ([`Description::check`] refuses it there): the step
+    /// and the edits test this, so such a build holds no code for masses.
     #[inline(always)]
     pub(crate) const fn has_masses(&self) -> bool {
         cfg!(feature = "mass") && self.per_particle_mass
@@ -318,9 +318,9 @@ impl Description {
     }
 
     /// `forces` with the terms this build leaves out false, as they are by
-    /// construction ([`Description::check`] refuses them): the vortex needs the
-    /// feature `vortex`, the force field and the potential `fields`. The
-    /// step reads this, so a build without them holds no code for them.
+    /// construction ([`Description::check`] refuses them): the vortex needs
+    /// the feature `vortex`, the force field and the potential `fields`.
+    /// The step reads this, so a build without them holds no code for them.
     #[inline(always)]
     pub(crate) const fn built_forces(&self) -> Forces {
         let fields = cfg!(feature = "fields");
@@ -336,16 +336,17 @@ impl Description {
     }
 
     /// `method`, [`Method::ExactFast`] by construction in a build without
-    /// the feature `all-methods` ([`Description::check`] refuses the others there):
-    /// the step reads this, so such a build holds no code for the others.
+    /// the feature `all-methods` ([`Description::check`] refuses the others
+    /// there): the step reads this, so such a build holds no code for the
+    /// others.
     #[inline(always)]
     pub(crate) const fn assignment(&self) -> Method {
         if cfg!(feature = "all-methods") { self.method } else { Method::ExactFast }
     }
 
     /// `collisions`, [`Collisions::Paper`] by construction in a build
-    /// without the feature `collision-rules` ([`Description::check`] refuses M5.2b
-    /// there), as [`Description::assignment`].
+    /// without the feature `collision-rules` ([`Description::check`]
+    /// refuses M5.2b there), as [`Description::assignment`].
     #[inline(always)]
     pub(crate) const fn collision_rule(&self) -> Collisions {
         if cfg!(feature = "collision-rules") { self.collisions } else { Collisions::Paper }
