@@ -1,6 +1,7 @@
-//! Checks of the values a caller hands in: finite numbers, restitutions,
-//! and masses (M1; speeds in `speed.rs`). One function each, used by every call that
-//! takes such a value, so that every call refuses the same values.
+//! Checks of the values a caller hands in: finite numbers, restitutions
+//! and masses (M1; speeds have `speed.rs`). One function each, used by
+//! every call that takes such a value, so that every call refuses the same
+//! values.
 
 use crate::Error;
 
