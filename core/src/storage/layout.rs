@@ -30,9 +30,9 @@ unsafe impl Plain for f32 {}
 // and every element accepts every bit pattern.
 unsafe impl<T: Plain, const N: usize> Plain for [T; N] {}
 // SAFETY: u32 and f32 fields, no padding, every bit pattern valid.
-unsafe impl Plain for crate::rules::obstacle::Surface {}
+unsafe impl Plain for Surface {}
 // SAFETY: u32 and f32 fields only, no padding, every bit pattern valid.
-unsafe impl Plain for crate::rules::emitter::Slot {}
+unsafe impl Plain for Slot {}
 
 /// Views a plane of `T` as whole groups of `N` (a cell's `N` velocity
 /// components, say); a partial group at the end is left out.
