@@ -1,5 +1,6 @@
-//! The scene description: what a world uses (M9), checked in full before any
-//! memory is touched, and the memory layout that follows from it.
+//! The scene description: what a world uses (M9), and its checks
+//! ([`Description::check`]), made in full before any memory is touched;
+//! the memory plan that follows from it is `storage/layout.rs`'s.
 
 use crate::Error;
 use crate::rules::assign::Method;

@@ -70,7 +70,8 @@ pub(crate) fn saturating_u64(x: f32) -> u64 {
 /// The square root, correctly rounded as IEEE 754 asks and as
 /// `libm::sqrtf` gives it. On Arm cores with a hard-float unit (the
 /// `eabihf` targets: VFP, which has the instruction) one `vsqrt.f32`,
-/// where libm is a software routine with a table of its own; elsewhere libm's (an instruction too where libm has one).
+/// where libm is a software routine with a table of its own; elsewhere
+/// libm's (an instruction too where libm has one).
 #[inline(always)]
 pub(crate) fn sqrt(x: f32) -> f32 {
     #[cfg(all(target_arch = "arm", target_abi = "eabihf"))]
