@@ -90,8 +90,8 @@ impl World {
         if self.is_obstacle(s) {
             return Err(Error::CellObstacle);
         }
-        crate::api::checks::mass(m)?;
-        // Last fallible step; it changes the world only when it succeeds.
+        // Last fallible step (it checks the mass first); it changes the
+        // world only when it succeeds.
         let index = self.mass_index_of(m)?;
         self.place_added(s, v, index);
         self.head.counters.particles += 1;
