@@ -50,11 +50,13 @@ use clib::{catching_library, library, root};
 
 use mpca::{Boundary, Collisions, Description, Drift, Emitter, Method, Quantization, Shape, Stats, World, WorldBox};
 
-/// Error cases `errors.c` must try. It tries 1,795 today; the margin is
-/// for cases merged or reworded, not for groups dropped.
+/// Error cases `errors.c` must try: a little below what it tries, so that
+/// cases merged or reworded pass and a dropped group of them fails (the
+/// run prints the count).
 const MIN_ERROR_CASES: u64 = 1700;
 
-/// Checks `cpp_wrapper.cpp` must make: 430 today (a THROWS is three).
+/// Checks `cpp_wrapper.cpp` must make (a THROWS is three): a little below
+/// what it makes, for the same reason.
 const MIN_CPP_CHECKS: u32 = 400;
 
 const SANITIZE_FLAGS: [&str; 3] = ["-fsanitize=address,undefined", "-fno-omit-frame-pointer", "-fno-sanitize-recover=all"];
