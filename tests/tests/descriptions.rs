@@ -290,7 +290,9 @@ fn memory_follows_the_scene() {
                 d.per_particle_mass = true;
                 d.mass_classes = 16;
             },
-            cells + 16 * 4,
+            // The index plane, the table, and the step's conversion of each
+            // class (M1c: 24 bytes a class).
+            cells + 16 * 4 + 16 * 24,
         );
         adds("force field", |d| d.forces.field = true, 4 * d * cells);
         adds("potential", |d| d.forces.potential = true, 4 * cells);

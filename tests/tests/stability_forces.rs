@@ -204,41 +204,46 @@ fn clamped_velocities_point_along_the_force() {
     }
 }
 
-/// M5.5 on a velocity some of whose components the force left undefined.
-/// collision.rs documents the rule: a component left undefined (inf - inf)
-/// counts as zero, infinite components become unit ones and finite ones
-/// vanish beside them; and the clamp only ever scales a velocity back to
-/// |v| = 1 (M5.5). Here, in 3D, at cell (4, 4, z) a potential cliff gives
-/// F_x = +inf and a vortex centred at (4.5, 4.25) with circulation 3e38
-/// gives F_x = -inf (so F_x = inf - inf) and F_y = 0 * inf; nothing is
-/// infinite along z, where gravity adds 0.001 per step. A particle there at
-/// rest, alone in its block. Expected after one step: x and y count as
-/// zero, so the stored velocity is (0, 0, 0.001) within one quantum per
-/// axis (its rounding), and in particular |v| stays far below 1.
+/// M5.5 on a velocity whose force terms overflow. In integers (M1c) a term
+/// whose conversion overflows saturates at `±2^61` fine units, so two
+/// opposite overflowing terms cancel exactly, and the sum is fitted to the
+/// working bound with its direction kept; the clamp only ever scales a
+/// velocity back to |v| = 1 (M5.5). Here, in 3D, at cell (4, 4, z) a
+/// potential cliff gives F_x = +MAX and a force field F_x = -MAX (so F_x
+/// cancels); nothing overflows along z, where gravity adds 0.001 per step.
+/// A particle there at rest, alone in its block. Expected after one step:
+/// the stored velocity is (0, 0, 0.001) within one quantum per axis (its
+/// rounding), and in particular |v| stays far below 1. With the field off,
+/// the cliff alone clamps the velocity to +x.
 #[test]
-fn undefined_force_components_count_as_zero() {
+fn opposite_overflowing_force_terms_cancel() {
     for q in QUANTS {
-        let mut desc = cube(3, 8);
-        desc.quantization = q;
-        desc.forces.uniform = true;
-        desc.forces.potential = true;
-        desc.forces.vortex = true;
-        desc.gravity = [0.0, 0.0, 0.001];
-        desc.vortex = Vortex { centre: [4.5, 4.25], core_radius: 1e-3, circulation: 3e38 };
-        desc.seed = 20;
-        let mut mem = memory(&desc);
-        let world = World::init(&desc, &mut mem).unwrap();
-        let u: Vec<f32> = cells(&desc).map(|p| if p[0] < 5 { f32::MAX } else { -f32::MAX }).collect();
-        world.set_potential(&u).unwrap();
-        world.add_particle([4, 4, 4], [0.0; 3]).unwrap();
-        world.step(1);
-        check_sane(world, 1, &format!("{q:?}"));
-        let p = world.particles().next().unwrap();
-        let x = stored(p.velocity, q);
-        let s = scale(q);
-        let want = [0.0, 0.0, 0.001 * s];
-        for k in 0..3 {
-            assert!((x[k] as f64 - want[k]).abs() < 1.0 + 1e-3, "{q:?}: stored {x:?} quanta, expected {want:?} within a quantum");
+        for field in [true, false] {
+            let mut desc = cube(3, 8);
+            desc.quantization = q;
+            desc.forces.uniform = true;
+            desc.forces.potential = true;
+            desc.forces.field = field;
+            desc.gravity = [0.0, 0.0, 0.001];
+            desc.seed = 20;
+            let mut mem = memory(&desc);
+            let world = World::init(&desc, &mut mem).unwrap();
+            let u: Vec<f32> = cells(&desc).map(|p| if p[0] < 5 { f32::MAX } else { -f32::MAX }).collect();
+            world.set_potential(&u).unwrap();
+            if field {
+                let f: Vec<f32> = cells(&desc).flat_map(|_| [-f32::MAX, 0.0, 0.0]).collect();
+                world.set_force_field(&f).unwrap();
+            }
+            world.add_particle([4, 4, 4], [0.0; 3]).unwrap();
+            world.step(1);
+            check_sane(world, 1, &format!("{q:?}"));
+            let p = world.particles().next().unwrap();
+            let x = stored(p.velocity, q);
+            let s = scale(q);
+            let want = if field { [0.0, 0.0, 0.001 * s] } else { [s, 0.0, 0.0] };
+            for k in 0..3 {
+                assert!((x[k] as f64 - want[k]).abs() < 1.0 + 1e-3, "{q:?} field {field}: stored {x:?} quanta, expected {want:?} within a quantum");
+            }
         }
     }
 }

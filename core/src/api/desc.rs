@@ -4,7 +4,7 @@
 
 use crate::Error;
 use crate::rules::assign::Method;
-use crate::api::checks::{finite, mass, restitution};
+use crate::api::checks::{finite, mass, negative, positive, restitution};
 
 /// What happens at one face of the domain (M4).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -258,24 +258,24 @@ impl Description {
         restitution(self.restitution)?;
         restitution(self.wall_restitution)?;
         finite(&[self.dt])?;
-        if self.dt < 0.0 {
+        if negative(self.dt) {
             return Err(Error::NegativeDt);
         }
         finite(&self.gravity)?;
         finite(&[self.vortex.centre[0], self.vortex.centre[1], self.vortex.core_radius, self.vortex.circulation])?;
-        if self.forces.vortex && self.vortex.core_radius <= 0.0 {
+        if self.forces.vortex && !positive(self.vortex.core_radius) {
             return Err(Error::BadVortex);
         }
         // M5.1b: a rate of 0 is off, and the wind is a velocity.
         finite(&[self.drag.rate])?;
         finite(&self.drag.wind)?;
-        if self.drag.rate < 0.0 {
+        if negative(self.drag.rate) {
             return Err(Error::BadDrag);
         }
         if !crate::api::speed::slow(&self.drag.wind[..dim]) {
             return Err(Error::SpeedRange);
         }
-        if self.drag.vortex && self.drag.rate > 0.0 && self.vortex.core_radius <= 0.0 {
+        if self.drag.vortex && positive(self.drag.rate) && !positive(self.vortex.core_radius) {
             return Err(Error::BadVortex);
         }
         if self.quantization == Quantization::Bits16 && !cfg!(feature = "q16") {
@@ -288,7 +288,7 @@ impl Description {
         let kept = self.has_masses() == self.per_particle_mass
             && self.has_obstacles() == self.obstacles
             && self.built_forces() == self.forces
-            && self.has_drag() == (self.drag.rate > 0.0)
+            && self.has_drag() == positive(self.drag.rate)
             && (cfg!(feature = "fields") || !self.drag.field)
             && self.assignment() == self.method
             && self.collision_rule() == self.collisions
@@ -333,7 +333,7 @@ impl Description {
     /// construction without the feature `fields`.
     #[inline(always)]
     pub(crate) fn has_drag(&self) -> bool {
-        cfg!(feature = "fields") && self.drag.rate > 0.0
+        cfg!(feature = "fields") && positive(self.drag.rate)
     }
 
     /// `method`, [`Method::ExactFast`] by construction in a build without

@@ -57,14 +57,16 @@ impl World {
     pub(crate) fn mass_index_of(&mut self, m: f32) -> Result<u8, Error> {
         crate::api::checks::mass(m)?;
         if !self.head.desc.has_masses() {
-            return if m == self.head.desc.mass { Ok(0) } else { Err(Error::NotEnabled) };
+            // Both positive (checked): equal exactly where their bits are.
+            return if m.to_bits() == self.head.desc.mass.to_bits() { Ok(0) } else { Err(Error::NotEnabled) };
         }
         let used = self.head.masses as usize;
         let (head, p) = self.planes::<u8>();
         if let Some(i) = p.mass_table[..used].iter().position(|&t| t.to_bits() == m.to_bits()) {
             return Ok(i as u8);
         }
-        if used >= p.mass_table.len() {
+        // The plane holds the step's classes after the table (`mass_plane`).
+        if used >= head.desc.mass_classes as usize {
             return Err(Error::MassTableFull);
         }
         p.mass_table[used] = m;
@@ -102,21 +104,21 @@ impl World {
     /// stochastically from `rng` (M1). Not inlined into the step, whose
     /// frame would grow by it, on firmware stacks too.
     #[inline(never)]
-    pub(crate) fn place_emitted(&mut self, s: Site, v: [f32; 3], mass_index: u8, life: u16, rng: &mut crate::rules::rng::Stream) {
-        self.place(s, v, mass_index, life, Some(rng));
+    pub(crate) fn place_emitted(&mut self, s: Site, x: [i32; 3], mass_index: u8, life: u16, rng: &mut crate::rules::rng::Stream) {
+        self.place(s, Velocity::Fine(x), mass_index, life, Some(rng));
     }
 
     /// Writes a particle a caller adds into a free cell, its components
     /// rounded to nearest. Apart from [`World::place_emitted`], so that a
     /// firmware that only emits does not carry this rounding.
     fn place_added(&mut self, s: Site, v: [f32; 3], mass_index: u8) {
-        self.place(s, v, mass_index, 0, None);
+        self.place(s, Velocity::Float(v), mass_index, 0, None);
     }
 
-    /// Writes a particle into a free cell. Components are rounded
-    /// stochastically from `stream` when one is given (M1), else to nearest.
+    /// Writes a particle into a free cell. Components in fine units are
+    /// rounded stochastically from `stream` (M1, M1c), floats to nearest.
     #[inline(always)]
-    fn place(&mut self, s: Site, v: [f32; 3], mass_index: u8, life: u16, stream: Option<&mut crate::rules::rng::Stream>) {
+    fn place(&mut self, s: Site, v: Velocity, mass_index: u8, life: u16, stream: Option<&mut crate::rules::rng::Stream>) {
         let d = self.dim();
         let summary_words = self.layout().summary_words;
         let per_mass = self.head.desc.has_masses();
@@ -127,9 +129,9 @@ impl World {
             mark(Cells::new(p.rows), Cells::new(p.words), summary_words, s.row, s.x);
             let r = stream.map(|rng| rng.next_u64());
             for k in 0..d {
-                p.velocity[s.cell * d + k] = match r {
-                    Some(r) => Q::from_int(Q::stochastic(v[k] * Q::SCALE, (r >> (16 * k)) as u32)),
-                    None => Q::nearest(v[k]),
+                p.velocity[s.cell * d + k] = match (v, r) {
+                    (Velocity::Fine(x), r) => Q::from_int(Q::stochastic(x[k], (r.unwrap_or(0) >> (16 * k)) as u32)),
+                    (Velocity::Float(v), _) => Q::nearest(v[k]),
                 };
             }
             if per_mass {
@@ -200,4 +202,12 @@ mod tests {
         assert_eq!(w.add_particle([1, 1, 0], [1.0001, 0.0, 0.0]), Err(Error::SpeedRange));
         assert_eq!(w.add_particle([1, 1, 0], [0.8, 0.7, 0.0]), Err(Error::SpeedRange));
     }
+}
+
+/// A velocity as [`World::place`] takes it: a caller's floats (rounded to
+/// nearest), or an emitter's fine units (rounded stochastically, M1c).
+#[derive(Clone, Copy)]
+enum Velocity {
+    Float([f32; 3]),
+    Fine([i32; 3]),
 }

@@ -8,6 +8,8 @@
 //! A particle's velocity is held to what a world can store (edit.rs,
 //! `storable`), decided in integers.
 
+use crate::api::checks::size;
+
 /// Whether `u` (1 to 3 finite components, as every caller has checked)
 /// has `|u| <= 1`, exactly: integers decide ([`too_fast`] with no spread),
 /// after the `f32` sum of the squares where that is far enough from 1 to
@@ -62,10 +64,12 @@ fn far_from_one(v: &[f32; 3]) -> Option<bool> {
 ///   units of 2^-298 both are integers below 2^301, which [`Wide`] adds
 ///   without loss and compares exactly.
 pub(crate) fn too_fast(v: [f32; 3], spread: f32) -> bool {
-    if spread >= 1.0 {
-        return spread > 1.0 || v.iter().any(|&c| c != 0.0);
+    // Sizes compared as integers (the values are finite, the spread not
+    // negative: every caller checked).
+    if size(spread) >= size(1.0) {
+        return size(spread) > size(1.0) || v.iter().any(|&c| size(c) != 0);
     }
-    if v.iter().any(|c| c.abs() > 1.0) {
+    if v.iter().any(|&c| size(c) > size(1.0)) {
         return true;
     }
     let (mut left, mut right) = (Wide::default(), Wide::default());

@@ -7,10 +7,9 @@
 //! `(seed, step, emitter index)` (M8).
 
 use crate::Error;
-use crate::api::checks::finite;
-use crate::rules::collision::random_unit;
+use crate::api::checks::{finite, negative};
+use crate::rules::fixed::{clamp_to, mulq, parts, sq, to_fine, unit_scale};
 use crate::rules::rng::Stream;
-use crate::rules::vector::clamp;
 
 /// An emitter as the caller describes it.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -56,7 +55,7 @@ pub(crate) fn checked(e: &mut Emitter, dim: usize, n: [usize; 3], lifetimes: boo
         e.max[2] = 1;
         e.velocity[2] = 0.0;
     }
-    if e.rate < 0.0 || e.spread < 0.0 || (0..3).any(|k| e.min[k] >= e.max[k] || e.max[k] as usize > n[k]) {
+    if negative(e.rate) || negative(e.spread) || (0..3).any(|k| e.min[k] >= e.max[k] || e.max[k] as usize > n[k]) {
         return Err(Error::BadEmitter);
     }
     if crate::api::speed::too_fast(e.velocity, e.spread) {
@@ -71,42 +70,60 @@ pub(crate) fn checked(e: &mut Emitter, dim: usize, n: [usize; 3], lifetimes: boo
     Ok(())
 }
 
-/// `floor(x)` for an `x` that is not negative (a rate: `checked`), by
-/// clearing the bits of its fraction: a few instructions where `floorf`
-/// is a library routine.
-pub(crate) fn floor_rate(x: f32) -> f32 {
-    let bits = x.to_bits();
-    let exponent = (bits >> 23 & 0xff) as i32 - 127;
-    if exponent < 0 {
-        // Below 1: no whole part (the sign kept, as floor keeps -0).
-        return f32::from_bits(bits & 0x8000_0000);
+/// M6: how many particles a step asks of an emitter of rate `rate` (not
+/// negative, finite: [`checked`]), from the bits of the float: the whole
+/// part (saturating) and the fraction's threshold, `ceil(f 2^24)` for the
+/// fraction `f = rate - floor(rate)`. A uniform 24-bit draw below the
+/// threshold is the trial of one more particle, with probability `f` to
+/// within `2^-24`: the float comparison `u 2^-24 < f`, exactly, without
+/// a float operation.
+pub(crate) fn split_rate(rate: f32) -> (u64, u32) {
+    let (_, m, e) = parts(rate);
+    if e >= 0 {
+        // No fraction; a whole part of 2^64 or more saturates.
+        let whole = if e > 40 { u64::MAX } else { m << e };
+        return (whole, 0);
     }
-    // 23 fraction bits, of which `exponent` lie above the point.
-    let fraction = 0x7f_ffffu32.checked_shr(exponent as u32).unwrap_or(0);
-    f32::from_bits(bits & !fraction)
+    let point = (-e) as u32;
+    let whole = m.checked_shr(point).unwrap_or(0);
+    let fraction = m - (whole << point.min(63));
+    // The fraction's bits at 2^24, rounded up.
+    let threshold = if point <= 24 {
+        fraction << (24 - point)
+    } else {
+        let cut = point - 24;
+        let kept = fraction.checked_shr(cut).unwrap_or(0);
+        kept + u64::from(kept.checked_shl(cut).unwrap_or(0) != fraction)
+    };
+    (whole, threshold as u32)
 }
 
-
-/// The emitter's velocity plus a uniform point of the disc or ball of radius
-/// `spread`.
-pub(crate) fn spread_velocity(e: &Emitter, dim: usize, rng: &mut Stream) -> [f32; 3] {
-    let mut v = e.velocity;
-    if e.spread > 0.0 {
-        // A build without 3D has only 2D worlds: the 3D branch (and cbrtf)
-        // is not linked into it.
-        let (dir, radius) = if dim == 2 || !cfg!(feature = "dim3") {
-            (random_unit::<2>(rng), crate::rules::vector::sqrt(rng.unit()))
-        } else {
-            (random_unit::<3>(rng), libm::cbrtf(rng.unit()))
+/// M6: an emitted particle's velocity in fine units of a world of `unit`
+/// fine units to a unit speed (M1c): the emitter's velocity converted,
+/// plus a point uniform in the disc (2D) or ball (3D) of radius `spread`,
+/// drawn by rejection in a square (cube) of side `2^16` around 0 (32 bits a
+/// try in 2D, 48 in 3D), then the clamp to a unit speed, uncounted (the
+/// speeds were checked: only the conversions can leave a hair over).
+pub(crate) fn spread_velocity(e: &Emitter, dim: usize, unit: i32, rng: &mut Stream) -> [i32; 3] {
+    let scale = unit_scale(unit);
+    let mut x = [0, 1, 2].map(|k| if k < dim { to_fine(e.velocity[k], scale) } else { 0 });
+    let radius = to_fine(e.spread, scale);
+    if radius > 0 {
+        // A build without 3D has only 2D worlds.
+        let three = dim == 3 && cfg!(feature = "dim3");
+        let p = loop {
+            let xy = rng.bits(32);
+            let z = if three { rng.bits(16) as i32 - (1 << 15) } else { 0 };
+            let p = [(xy & 0xffff) as i32 - (1 << 15), (xy >> 16) as i32 - (1 << 15), z];
+            if sq::<3>(p) <= 1 << 30 {
+                break p;
+            }
         };
         for k in 0..3 {
-            v[k] += e.spread * radius * dir[k];
+            x[k] += mulq(p[k], radius, 15);
         }
     }
-    // |velocity| + spread <= 1 was checked; rounding may still leave a hair
-    // over 1, which is no clamp of the model's, so it is not counted.
-    let _ = clamp(&mut v, 1.0);
-    v
+    clamp_to::<3>(x, unit)
 }
 
 #[cfg(test)]
@@ -117,23 +134,36 @@ mod tests {
     use crate::rules::rng::block_stream;
 
     #[test]
-    fn floor_rate_is_floor_for_rates() {
-        // Expect: floorf's value, bit for bit, for 0, -0, every power of
-        // two's neighbours, infinity and random values of every size.
+    fn the_rate_split_is_the_float_draw() {
+        // Expect: the whole part is the saturating cast of floor(rate),
+        // and for every 24-bit draw u (the edges of the threshold and
+        // random ones) u < threshold exactly where u 2^-24 < rate -
+        // floor(rate) in f64 (exact for these values): for 0, every
+        // power of two's neighbours, and random rates of every size.
         let mut rng = block_stream(9, 9, 9);
-        let check = |x: f32| assert_eq!(floor_rate(x).to_bits(), libm::floorf(x).to_bits(), "{x:e}");
-        check(0.0);
-        check(-0.0);
-        check(f32::INFINITY);
+        let check = |x: f32, u: u32| {
+            let (whole, threshold) = split_rate(x);
+            let floor = libm::floor(f64::from(x));
+            assert_eq!(whole, floor as u64, "{x:e}");
+            for u in [u, threshold.saturating_sub(1), threshold, threshold + 1, (1 << 24) - 1] {
+                let u = u & 0xff_ffff;
+                let want = f64::from(u) / 16_777_216.0 < f64::from(x) - floor;
+                assert_eq!(u < threshold, want, "{x:e} {u}");
+            }
+        };
+        check(0.0, 0);
         for e in 0..255u32 {
             let x = f32::from_bits(e << 23);
             for k in 0..3 {
-                check(f32::from_bits(x.to_bits() + k));
-                check(f32::from_bits((x.to_bits() + k).saturating_sub(3)));
+                check(f32::from_bits(x.to_bits() + k), rng.bits(24));
+                check(f32::from_bits((x.to_bits() + k).saturating_sub(3)), rng.bits(24));
             }
         }
         for _ in 0..crate::sized(100_000, 1_000) {
-            check(f32::from_bits(rng.bits(31)));
+            let x = f32::from_bits(rng.bits(31));
+            if x.is_finite() {
+                check(x, rng.bits(24));
+            }
         }
     }
 }

@@ -2,17 +2,17 @@
 //! periodic, wall or open, for a cell coordinate that may be outside it.
 
 use crate::api::desc::Boundary;
-use crate::rules::vector::normalise;
 
 /// Where a cell coordinate lands under the boundary rules of M4.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) enum Beyond {
     /// A cell of the domain, wrapped across periodic faces.
     Inside([usize; 3]),
-    /// Beyond a wall: an obstacle with this unit inward normal (the
-    /// normalised sum of the walls' normals where walls meet). A cell beyond
-    /// both a wall and an open face is wall.
-    Wall([f32; 3]),
+    /// Beyond a wall: an obstacle whose inward normal is the sum of the
+    /// walls' axis normals, given here by its signs (-1, 0 or 1 per axis:
+    /// an axis or a diagonal, which M1c normalises by constants). A cell
+    /// beyond both a wall and an open face is wall.
+    Wall([i32; 3]),
     /// Beyond open faces only: a particle sent there leaves.
     Open,
 }
@@ -33,7 +33,7 @@ pub(crate) type Coords = [isize; 3];
 /// (no 64-bit division, which small cores call a library routine for).
 pub(crate) fn resolve(n: [usize; 3], boundary: &[[Boundary; 2]; 3], c: Coords) -> Beyond {
     let mut out = [0usize; 3];
-    let mut wall = [0.0f32; 3];
+    let mut wall = [0i32; 3];
     let (mut is_wall, mut is_open) = (false, false);
     for k in 0..3 {
         let nk = n[k] as isize;
@@ -49,13 +49,13 @@ pub(crate) fn resolve(n: [usize; 3], boundary: &[[Boundary; 2]; 3], c: Coords) -
             }
             Boundary::Wall => {
                 is_wall = true;
-                wall[k] = if high { -1.0 } else { 1.0 };
+                wall[k] = if high { -1 } else { 1 };
             }
             Boundary::Open => is_open = true,
         }
     }
     if is_wall {
-        Beyond::Wall(normalise(wall).unwrap_or([0.0; 3]))
+        Beyond::Wall(wall)
     } else if is_open {
         Beyond::Open
     } else {

@@ -5,6 +5,7 @@ pub mod assign;
 pub(crate) mod collision;
 pub(crate) mod emitter;
 pub(crate) mod faces;
+pub(crate) mod fixed;
 pub(crate) mod force;
 pub(crate) mod obstacle;
 pub(crate) mod quant;

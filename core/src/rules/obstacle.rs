@@ -12,6 +12,7 @@
 use crate::Error;
 use crate::api::checks::finite;
 use crate::rules::vector::{dot, normalise};
+use crate::rules::fixed::{mulq, sat, scaled, DIAGONAL_Q30};
 
 /// One obstacle surface cell.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -67,20 +68,47 @@ pub enum Shape {
     },
 }
 
-/// Eq. 9: `v' = v - (1 + e)(N.v)N`, for a particle moving into the surface
-/// (`N.v < 0`; the step makes sure of that by choosing `N`). A particle
-/// moving away along `N` is returned unchanged, never turned back into the
+/// Eq. 9 in fine units (M1c): `v' = v - (1 + e)(N.v)N` with the normal
+/// `n` in Q30 and the restitution `e` in Q16, for a particle moving into
+/// the surface (`N.v < 0`; the step makes sure of that by choosing `N`).
+/// `N.v` is the exact dot product, rounded down once. A particle moving
+/// away along `N` is returned unchanged, never turned back into the
 /// obstacle.
 #[inline]
-pub(crate) fn reflect(v: [f32; 3], n: [f32; 3], e: f32) -> [f32; 3] {
-    let vn = dot(v, n);
-    if vn >= 0.0 {
+pub(crate) fn reflect(v: [i32; 3], n: [i32; 3], e: i32) -> [i32; 3] {
+    let exact = dot_q30(v, n);
+    if exact >= 0 {
         return v;
     }
-    let s = (1.0 + e) * vn;
-    [v[0] - s * n[0], v[1] - s * n[1], v[2] - s * n[2]]
+    let s = mulq(sat(exact >> 30), (1 << 16) + e, 16);
+    [0, 1, 2].map(|k| sat(i64::from(v[k]) - i64::from(mulq(s, n[k], 30))))
 }
 
+/// The exact dot product of a velocity (or a Q30 vector) with a Q30 one.
+#[inline]
+pub(crate) fn dot_q30(v: [i32; 3], n: [i32; 3]) -> i64 {
+    (0..3).map(|k| i64::from(v[k]) * i64::from(n[k])).sum()
+}
+
+/// A normal in Q30 (M1c), converted from its float where it is read:
+/// `round(n_k 2^30)`.
+#[inline]
+pub(crate) fn normal_q30(n: [f32; 3]) -> [i32; 3] {
+    n.map(|c| scaled(c, 1.0, 30).clamp(-(1 << 30), 1 << 30) as i32)
+}
+
+/// The unit vector along `dir`, whose components are -1, 0 or 1, in Q30
+/// from the exact constants of M1c (an axis, a 2D or a 3D diagonal).
+#[inline]
+pub(crate) fn axis_q30(dir: [i32; 3]) -> [i32; 3] {
+    let count = dir.iter().filter(|&&c| c != 0).count();
+    let unit = match count {
+        1 => 1 << 30,
+        2 => DIAGONAL_Q30[0],
+        _ => DIAGONAL_Q30[1],
+    };
+    dir.map(|c| c * unit)
+}
 
 /// The surface entry of `cell`, if any, by binary search.
 #[inline]

@@ -30,6 +30,11 @@ macro_rules! with_quant {
 }
 pub(crate) use with_quant;
 
+/// Fine units to a unit speed (M1c's `W`) of a world of `quantization`.
+pub(crate) fn unit_of(quantization: crate::api::desc::Quantization) -> i32 {
+    with_quant!(quantization, Q => Q::UNIT)
+}
+
 /// A stored velocity component type.
 pub(crate) trait Quant: Copy + Default + Send + crate::storage::layout::Plain + 'static {
     /// Stored steps per unit speed.
@@ -59,46 +64,27 @@ pub(crate) trait Quant: Copy + Default + Send + crate::storage::layout::Plain + 
         Self::from_int(libm::roundf(v.clamp(-1.0, 1.0) * Self::SCALE) as i32)
     }
 
-    /// Stochastic rounding of `x`, a velocity component in quanta (clamped
-    /// to the stored range), with 16 random bits `r`: the integer part of
-    /// `x` rounded down, plus one for a share of the `2^16` values of `r`
-    /// equal to the fraction of `x` on a grid of `2^-16` quanta. `E[result]
-    /// = x` to within `2^-16` of a quantum; an integer `x` is returned as it
-    /// is, and NaN gives 0.
-    ///
-    /// 8-bit storage adds `x + 128` (in `[1, 255]`, where `f32` steps are
-    /// `2^-16` or finer) and `r 2^-16` in `f32` and truncates: the sum needs
-    /// no rounding above 128, so it is one add and one conversion. 16-bit
-    /// storage would lose bits that way and puts `x` on the grid in fixed
-    /// point first.
+    /// Fine units a quantum (M1c's `F`): `2^FINE` of them make one.
+    const FINE: u32;
+    /// Fine units to a unit speed (M1c's `W`, `SCALE 2^FINE`).
+    const UNIT: i32;
+
+    /// Stochastic rounding of `x`, a working component in fine units
+    /// within a unit speed (every stage that changes a velocity ends with
+    /// the clamp, M5.5), with the low [`Quant::FINE`] of 16 random bits `r`
+    /// (M1c): `(x + r) >> FINE`. Its mean is `x / 2^FINE` exactly, and a
+    /// whole number of quanta comes back as it is.
     #[inline(always)]
-    fn stochastic(x: f32, r: u32) -> i32 {
-        let x = x.clamp(-Self::SCALE, Self::SCALE);
-        if Self::SCALE < 128.0 {
-            // NaN as 0, which the sum below rounds to 0: a select, not a
-            // branch, so that several components round in one vector.
-            let x = if crate::rules::vector::is_nan(x) { 0.0 } else { x };
-            let y = (x + 128.0) + crate::rules::vector::small_to_f32(r & 0xffff) * (1.0 / 65536.0);
-            // x is in [-127, 127] (clamped, and not NaN), so y is finite
-            // and in [1, 256): its integer part fits an i32. (A checked
-            // cast would test for NaN and both bounds again.)
-            return crate::rules::vector::whole_part(y) - 128;
-        }
-        if crate::rules::vector::is_nan(x) {
-            return 0;
-        }
-        let x = x * 65536.0;
-        // SAFETY: x is in [-32767, 32767] 2^16 (clamped, not NaN): the sum is
-        // finite and its magnitude below 2^31, so it fits an i32.
-        let fixed = unsafe { (x + 0.5f32.copysign(x)).to_int_unchecked::<i32>() };
-        (fixed >> 16) + i32::from(r & 0xffff < (fixed & 0xffff) as u32)
+    fn stochastic(x: i32, r: u32) -> i32 {
+        debug_assert!((-Self::UNIT..=Self::UNIT).contains(&x));
+        (x + (r & ((1 << Self::FINE) - 1)) as i32) >> Self::FINE
     }
 
-    /// M1: every component of `x` (in quanta) rounded stochastically, 16
-    /// bits of the stream a component: 32 bits in 2D, a whole 64-bit output
-    /// in 3D.
+    /// M1: every component of `x` (in fine units) rounded stochastically,
+    /// 16 bits of the stream a component: 32 bits in 2D, a whole 64-bit
+    /// output in 3D.
     #[inline(always)]
-    fn round<const D: usize>(x: [f32; 3], rng: &mut Stream) -> [i32; D] {
+    fn round<const D: usize>(x: [i32; 3], rng: &mut Stream) -> [i32; D] {
         let r = if D == 2 { u64::from(rng.bits(32)) } else { rng.next_u64() };
         let mut out = [0; D];
         for k in 0..D {
@@ -115,12 +101,12 @@ pub(crate) trait Quant: Copy + Default + Send + crate::storage::layout::Plain + 
     fn move_limit(table: &[u16; 256], drift: Drift, q: i32) -> u32;
 }
 
-/// `round(p 2^16)` for `p = a/127` (paper) and `p = 2a/(127 + a)`
-/// (calibrated), `a` in quanta, in integers so the tables are exact and the
-/// same on every target.
-const fn threshold_8(calibrated: bool, a: u32) -> u32 {
-    let (num, den) = if calibrated { (2 * a, 127 + a) } else { (a, 127) };
-    ((num << 17) + den) / (2 * den)
+/// `round(p 2^16)` for `p = a/S` (paper) and `p = 2a/(S + a)`
+/// (calibrated), `a` in quanta of `1/S`, in integers so the thresholds are
+/// exact and the same on every target.
+const fn threshold(calibrated: bool, a: u32, scale: u32) -> u32 {
+    let (num, den) = if calibrated { (2 * a as u64, (scale + a) as u64) } else { (a as u64, scale as u64) };
+    (((num << 17) + den) / (2 * den)) as u32
 }
 
 /// Per stored byte `q` (as `u8`), one less than the threshold of `|q|`:
@@ -133,7 +119,7 @@ const fn move_table(calibrated: bool) -> [u16; 256] {
     while b < 256 {
         let q = b as u8 as i8 as i32;
         let a = if q < 0 { -q } else { q };
-        t[b] = (threshold_8(calibrated, if a > 127 { 127 } else { a } as u32) - 1) as u16;
+        t[b] = (threshold(calibrated, if a > 127 { 127 } else { a } as u32, 127) - 1) as u16;
         b += 1;
     }
     t
@@ -179,6 +165,8 @@ pub(crate) fn move_tops_8(drift: Drift) -> &'static [u8; 256] {
 
 impl Quant for i8 {
     const SCALE: f32 = 127.0;
+    const FINE: u32 = 16;
+    const UNIT: i32 = 127 << 16;
     const LANES: bool = true;
     #[inline(always)]
     fn lanes_2d<const D: usize>(pair: [[Self; D]; 2]) -> u32 {
@@ -208,6 +196,8 @@ impl Quant for i8 {
 #[cfg(feature = "q16")]
 impl Quant for i16 {
     const SCALE: f32 = 32767.0;
+    const FINE: u32 = 12;
+    const UNIT: i32 = 32767 << 12;
     const LANES: bool = false;
     fn lanes_2d<const D: usize>(_: [[Self; D]; 2]) -> u32 {
         0
@@ -225,15 +215,9 @@ impl Quant for i16 {
     }
     #[inline]
     fn move_limit(_: &[u16; 256], drift: Drift, q: i32) -> u32 {
-        // 32,768 thresholds would not fit a table; f32 holds a/32767 to
-        // 2^-24, far finer than the 2^-16 steps of the threshold.
-        let a = crate::rules::vector::small_to_f32(q.unsigned_abs().min(32767)) * (1.0 / Self::SCALE);
-        let p = match drift {
-            Drift::Paper => a,
-            Drift::Calibrated => crate::rules::vector::div(2.0 * a, 1.0 + a),
-        };
-        // 0 for q = 0 (which never moves: M5.3 asks only inward axes).
-        ((p * 65536.0 + 0.5) as u32).saturating_sub(1)
+        // 32,768 thresholds would not fit a table: the 8-bit table's
+        // formula, computed for the one component.
+        threshold(drift == Drift::Calibrated, q.unsigned_abs().min(32767), 32767).saturating_sub(1)
     }
 }
 
@@ -242,24 +226,37 @@ mod tests {
     use super::*;
     use crate::rules::rng::block_stream;
 
-    fn mean_of<Q: Quant>(x: f32, n: u32) -> f64 {
+    fn mean_of<Q: Quant>(x: i32, n: u32) -> f64 {
         let mut rng = block_stream(3, 0, 0);
         (0..n).map(|_| f64::from(Q::stochastic(x, rng.bits(16)))).sum::<f64>() / f64::from(n)
     }
 
+    /// `x` quanta in fine units of `Q`, to nearest.
+    fn fine<Q: Quant>(x: f64) -> i32 {
+        (x * f64::from(1u32 << Q::FINE)).round() as i32
+    }
+
     #[test]
     fn rounding_up_happens_for_the_fraction_of_draws() {
-        // Expect: over all 2^16 values of r, x = lo + f rounds up for
-        // round(f 2^16) of them (within one), for both signs. Under Miri
-        // every 64th r: the values of r that round up are one contiguous
-        // range, so the sample counts its length / 64 to within one.
+        // Expect: over all 2^16 values of r, x = lo + phi (phi fine units
+        // above lo quanta) rounds up for exactly phi 2^(16 - F) of them,
+        // for both signs and widths. Under Miri every 64th r: the values
+        // of r that round up are spread evenly over each 2^F, so the
+        // sample counts them / 64 to within one.
         let stride = crate::sized(1, 64);
-        for x in [10.3f32, -9.7, 0.3, -0.7, 0.0, 126.99, -126.01] {
-            let lo = libm::floorf(x);
-            let ups = (0..1u32 << 16).step_by(stride).filter(|&r| i8::stochastic(x, r) == lo as i32 + 1).count() as f64;
-            let want = f64::from(x - lo) * 65536.0;
-            assert!((ups * stride as f64 - want).abs() <= stride as f64, "{x}: {ups}");
+        fn check<Q: Quant>(stride: usize) {
+            for x in [10.3f64, -9.7, 0.3, -0.7, 0.0, 126.99, -126.01] {
+                let x = fine::<Q>(x);
+                let lo = x >> Q::FINE;
+                let phi = x - (lo << Q::FINE);
+                let ups = (0..1u32 << 16).step_by(stride).filter(|&r| Q::stochastic(x, r) == lo + 1).count();
+                let want = (phi as usize) << (16 - Q::FINE);
+                assert!((ups * stride).abs_diff(want) < stride, "{x}: {ups}");
+            }
         }
+        check::<i8>(stride);
+        #[cfg(feature = "q16")]
+        check::<i16>(stride);
     }
 
     #[test]
@@ -269,9 +266,9 @@ mod tests {
         // the mean = sqrt(.21/n) quanta.
         let n = crate::sized(100_000, 4_000) as u32;
         let sd = (0.21f64 / f64::from(n)).sqrt();
-        for (x, want) in [(10.3f32, 10.3f64), (-9.7, -9.7), (0.3, 0.3), (-0.7, -0.7)] {
-            let mean = mean_of::<i8>(x, n);
-            assert!((mean - want).abs() < 5.0 * sd, "{x}: {mean} vs {want}");
+        for want in [10.3f64, -9.7, 0.3, -0.7] {
+            let mean = mean_of::<i8>(fine::<i8>(want), n);
+            assert!((mean - want).abs() < 5.0 * sd, "{want}: {mean}");
         }
     }
 
@@ -279,14 +276,13 @@ mod tests {
     fn integers_in_quanta_stay_put() {
         for q in -127..=127 {
             for r in [0, 1, 0x7fff, 0xffff] {
-                assert_eq!(i8::stochastic(q as f32, r), q);
+                assert_eq!(i8::stochastic(q << 16, r), q);
             }
         }
-        // Beyond the range: clamped.
-        assert_eq!(i8::stochastic(300.5, 0), 127);
-        assert_eq!(i8::stochastic(-1e30, 0xffff), -127);
+        assert_eq!(i8::stochastic(i8::UNIT, 0xffff), 127);
+        assert_eq!(i8::stochastic(-i8::UNIT, 0xffff), -127);
         #[cfg(feature = "q16")]
-        assert_eq!(i16::stochastic(-32767.0, 0), -32767);
+        assert_eq!(i16::stochastic(-32767 << 12, 0), -32767);
     }
 
     #[test]

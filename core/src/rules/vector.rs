@@ -1,6 +1,8 @@
-//! The few vector operations the model needs, on `[f32; 3]` (the third
-//! component 0 in 2D): dot product, normalisation, and the speed clamp of
-//! M5.5.
+//! The float operations of the API and of a step's set-up, outside the
+//! block rule (which computes in integers, M1c): on `[f32; 3]` (the third
+//! component 0 in 2D) the dot product and normalisation (of obstacle
+//! normals, M7), and a division and square root correctly rounded on every
+//! target, for the conversions of M1c and the checks of a caller's values.
 
 /// Whether the core has no floating-point unit (Arm without hard float):
 /// there every operation on floats but a move is a library call, and the
@@ -23,48 +25,6 @@ pub(crate) fn dot_of<const D: usize>(a: [f32; 3], b: [f32; 3]) -> f32 {
         sum += a[k] * b[k];
     }
     sum
-}
-
-/// `v != [0.0; 3]`: whether a component is not zero (of either sign) or
-/// is NaN. On cores without an FPU from the bits (no comparisons of
-/// floats, each a library call there), elsewhere the comparison.
-#[inline(always)]
-pub(crate) fn nonzero(v: [f32; 3]) -> bool {
-    if NO_FPU { bitwise_nonzero(v) } else { v != [0.0; 3] }
-}
-
-/// [`nonzero`] from the bits: a set bit other than the signs.
-#[inline(always)]
-fn bitwise_nonzero(v: [f32; 3]) -> bool {
-    (v[0].to_bits() | v[1].to_bits() | v[2].to_bits()) << 1 != 0
-}
-
-/// The larger of `a` and `b`, neither of them NaN: `f32::max` without the
-/// library's `fmaxf` (a call on cores without the instruction), whose NaN
-/// rules such inputs never need.
-#[inline(always)]
-pub(crate) fn larger(a: f32, b: f32) -> f32 {
-    if a > b { a } else { b }
-}
-
-/// `x as u64` (toward zero; NaN and below 0 give 0, from 2^64 on
-/// `u64::MAX`) from the bits of `x`: on 32-bit cores the cast is a library
-/// routine.
-pub(crate) fn saturating_u64(x: f32) -> u64 {
-    let bits = x.to_bits();
-    // Negative (sign set) or NaN (above the bits of infinity): 0.
-    if bits >= 0x8000_0000 || bits > 0x7f80_0000 {
-        return 0;
-    }
-    let exponent = (bits >> 23) as i32 - 127;
-    if exponent < 0 {
-        return 0;
-    }
-    if exponent >= 64 {
-        return u64::MAX;
-    }
-    let mantissa = u64::from(bits & 0x7f_ffff | 0x80_0000);
-    if exponent >= 23 { mantissa << (exponent - 23) } else { mantissa >> (23 - exponent) }
 }
 
 /// The square root, correctly rounded as IEEE 754 asks and as
@@ -290,113 +250,10 @@ pub(crate) fn small_to_f32(x: u32) -> f32 {
     }
 }
 
-/// `x.is_nan()`. On Arm cores without an FPU [`bitwise_is_nan`], where
-/// the comparison is a library routine (`__aeabi_fcmpun`) that nothing
-/// else there needs; elsewhere the comparison, one instruction that
-/// vectorises.
-#[inline(always)]
-pub(crate) fn is_nan(x: f32) -> bool {
-    if NO_FPU { bitwise_is_nan(x) } else { x.is_nan() }
-}
-
-/// `x.is_nan()` from its bits: the magnitude's above infinity's.
-#[inline(always)]
-fn bitwise_is_nan(x: f32) -> bool {
-    x.to_bits() & 0x7fff_ffff > 0x7f80_0000
-}
-
-/// The integer part of a `y` in `[1, 2^24)`, `y as i32`. On Arm cores
-/// without an FPU [`bitwise_whole_part`], where the cast is a library
-/// routine (`__aeabi_f2iz`) that only the stochastic rounding of 8-bit
-/// velocities (`Quant::stochastic`) calls; elsewhere the cast.
-#[inline(always)]
-pub(crate) fn whole_part(y: f32) -> i32 {
-    debug_assert!((1.0..16_777_216.0).contains(&y));
-    if NO_FPU {
-        bitwise_whole_part(y)
-    } else {
-        // SAFETY: y is finite and below 2^31 (the caller's bound).
-        unsafe { y.to_int_unchecked::<i32>() }
-    }
-}
-
-/// The integer part of a `y` in `[1, 2^24)` from its bits: the significand
-/// with its top bit (a value in `[2^23, 2^24)`), shifted right by 23 less
-/// the exponent (150 less the exponent field; 0 to 23 places).
-#[inline(always)]
-fn bitwise_whole_part(y: f32) -> i32 {
-    let bits = y.to_bits();
-    ((bits & 0x7f_ffff | 0x80_0000) >> (150 - (bits >> 23))) as i32
-}
-
 /// `v / |v|`, or `None` where the length is zero or not finite.
 pub(crate) fn normalise(v: [f32; 3]) -> Option<[f32; 3]> {
     let len = sqrt(dot(v, v));
     (len.is_finite() && len > 1e-6).then(|| [div(v[0], len), div(v[1], len), div(v[2], len)])
-}
-
-/// M5.5: scales `v` back to `|v| = limit` if it is longer, returning the
-/// squared length it had (`None` if nothing changed). `limit` is 1 for
-/// velocities in cells per step, `SCALE` for velocities in quanta.
-///
-/// A velocity that overflowed `f32` (a force of 1e30 over a mass of 1e-30)
-/// keeps its direction: infinite components become unit ones and finite
-/// ones vanish beside them; a component left undefined (`inf - inf`) counts
-/// as zero. The squared length is then reported as infinite.
-#[inline]
-pub(crate) fn clamp(v: &mut [f32; 3], limit: f32) -> Option<f32> {
-    clamp_of::<3>(v, limit)
-}
-
-/// [`clamp`] of a velocity whose components from `D` on are 0.
-#[inline(always)]
-pub(crate) fn clamp_of<const D: usize>(v: &mut [f32; 3], limit: f32) -> Option<f32> {
-    let s2 = dot_of::<D>(*v, *v);
-    if s2 <= limit * limit {
-        return None;
-    }
-    let (w, s2) = clamp_long(*v, s2, limit);
-    *v = w;
-    Some(s2)
-}
-
-/// The part of [`clamp`] that runs only when it clamps: `s2` is the squared
-/// length of `v`, more than `limit` squared (or NaN); the clamped velocity
-/// and `s2` (infinity where `v` overflowed) come back. By value: a velocity
-/// whose address never escapes stays in registers.
-#[cold]
-pub(crate) fn clamp_long(mut v: [f32; 3], s2: f32, limit: f32) -> ([f32; 3], f32) {
-    let v = &mut v;
-    if !s2.is_finite() {
-        // In units of the limit, so that "short enough" means length <= 1.
-        for c in v.iter_mut() {
-            *c = div(*c, limit);
-        }
-        let big = v.iter().filter(|c| !is_nan(**c)).fold(0.0f32, |b, c| larger(b, c.abs()));
-        for c in v.iter_mut() {
-            *c = if is_nan(*c) || big == 0.0 {
-                0.0
-            } else if big.is_infinite() {
-                if c.is_infinite() { c.signum() } else { 0.0 }
-            } else if big > 1.0 {
-                div(*c, big)
-            } else {
-                // Only a NaN made the length undefined; what is left is
-                // already short enough and keeps its size.
-                *c
-            };
-        }
-        let _ = clamp(v, 1.0);
-        for c in v.iter_mut() {
-            *c *= limit;
-        }
-        return (*v, f32::INFINITY);
-    }
-    let scale = div(limit, sqrt(s2));
-    for c in v.iter_mut() {
-        *c *= scale;
-    }
-    (*v, s2)
 }
 
 #[cfg(test)]
@@ -542,120 +399,5 @@ mod tests {
             bits = bits.wrapping_mul(0x9e37_79b9).wrapping_add(0x7f4a_7c15);
             check(bits >> 1);
         }
-    }
-
-    #[test]
-    fn bitwise_is_nan_is_is_nan() {
-        // Expect: `is_nan` for every exponent's neighbours, both signs
-        // (zeros, subnormals, infinities, quiet and signalling NaNs) and
-        // random bit patterns.
-        edges_and_random(0x3c6e_f372, |x| assert_eq!(bitwise_is_nan(x), x.is_nan(), "{:#x}", x.to_bits()));
-    }
-
-    #[test]
-    fn bitwise_nonzero_is_not_all_zeros() {
-        // Expect: `v != [0.0; 3]` for every float at each place beside
-        // zeros of either sign, and beside another float.
-        edges_and_random(0x6a09_e667, |x| {
-            for v in [[x, 0.0, -0.0], [-0.0, x, 0.0], [0.0, 0.0, x], [x, 1.0, x]] {
-                assert_eq!(bitwise_nonzero(v), v != [0.0; 3], "{v:?}");
-            }
-        });
-    }
-
-    /// Calls `check` with the first and last four values of every
-    /// exponent, both signs (zeros, subnormals, infinities, quiet and
-    /// signalling NaNs among them), then with random bit patterns drawn
-    /// from `seed`.
-    fn edges_and_random(seed: u32, check: impl Fn(f32)) {
-        for e in 0..256u32 {
-            for k in 0..4 {
-                for sign in [0, 0x8000_0000] {
-                    check(f32::from_bits(sign | ((e << 23) + k)));
-                    check(f32::from_bits(sign | (((e << 23) | 0x7f_ffff) - k)));
-                }
-            }
-        }
-        let mut bits = seed;
-        for _ in 0..crate::sized(200_000, 2_000) {
-            bits = bits.wrapping_mul(0x9e37_79b9).wrapping_add(0x7f4a_7c15);
-            check(f32::from_bits(bits));
-        }
-    }
-
-    #[test]
-    fn bitwise_whole_part_is_the_cast() {
-        // Expect: `as i32` bit for bit over [1, 2^24): every exponent's
-        // first and last values and their neighbours, every value of
-        // [1, 256) on a grid of 2^-16 (what `Quant::stochastic` hands it),
-        // and random values.
-        let check = |y: f32| assert_eq!(bitwise_whole_part(y), y as i32, "{y:e} {:#x}", y.to_bits());
-        for e in 127..151u32 {
-            for k in 0..64 {
-                check(f32::from_bits((e << 23) + k));
-                check(f32::from_bits(((e << 23) | 0x7f_ffff) - k));
-            }
-        }
-        for i in (65_536..256 * 65_536).step_by(crate::sized(1, 997)) {
-            check(i as f32 * (1.0 / 65536.0));
-        }
-        let mut bits = 0x5be0_cd19u32;
-        for _ in 0..crate::sized(200_000, 2_000) {
-            bits = bits.wrapping_mul(0x9e37_79b9).wrapping_add(0x7f4a_7c15);
-            check(f32::from_bits(0x3f80_0000 + bits % (24 << 23)));
-        }
-    }
-
-    #[test]
-    fn saturating_u64_is_the_cast() {
-        // Expect: `as u64` bit for bit, for every exponent's neighbours,
-        // both signs, zeros, infinities, NaNs and random bit patterns.
-        edges_and_random(0x1234_5678, |x| assert_eq!(saturating_u64(x), x as u64, "{x:e} {:#x}", x.to_bits()));
-    }
-
-    #[test]
-    fn clamp_survives_overflow() {
-        // Expectation: a finite unit vector along the overflowing direction,
-        // zero where the direction is undefined, and an infinite length.
-        for (v, want) in [
-            ([f32::INFINITY, 1.0, 0.0], [1.0, 0.0, 0.0]),
-            ([f32::NEG_INFINITY, f32::INFINITY, 0.0], [-core::f32::consts::FRAC_1_SQRT_2, core::f32::consts::FRAC_1_SQRT_2, 0.0]),
-            ([3e38, 3e38, 0.0], [core::f32::consts::FRAC_1_SQRT_2, core::f32::consts::FRAC_1_SQRT_2, 0.0]),
-            ([f32::NAN, 0.0, 2.0], [0.0, 0.0, 1.0]),
-            ([f32::NAN, 0.25, 0.0], [0.0, 0.25, 0.0]),
-            ([f32::NAN, f32::NAN, f32::NAN], [0.0, 0.0, 0.0]),
-        ] {
-            let mut u = v;
-            assert_eq!(clamp(&mut u, 1.0), Some(f32::INFINITY), "{v:?}");
-            for k in 0..3 {
-                assert!((u[k] - want[k]).abs() < 1e-6, "{v:?} -> {u:?}");
-            }
-        }
-    }
-
-    #[test]
-    fn clamp_in_quanta_keeps_short_components_beside_a_nan() {
-        // Expect: with limit 127, a NaN next to a short component leaves
-        // the component as it is (not scaled by the limit).
-        let mut v = [f32::NAN, 0.0, 0.127];
-        assert_eq!(clamp(&mut v, 127.0), Some(f32::INFINITY));
-        assert_eq!(v, [0.0, 0.0, 0.127]);
-        let mut v = [f32::INFINITY, 5.0, 0.0];
-        assert_eq!(clamp(&mut v, 127.0), Some(f32::INFINITY));
-        assert_eq!(v, [127.0, 0.0, 0.0]);
-    }
-
-    #[test]
-    fn clamp_reports_the_squared_length() {
-        let mut v = [0.6, 0.8, 0.0];
-        assert_eq!(clamp(&mut v, 1.0), None);
-        let mut v = [2.0, 0.0, 0.0];
-        assert_eq!(clamp(&mut v, 1.0), Some(4.0));
-        assert_eq!(v, [1.0, 0.0, 0.0]);
-        // In quanta the result may sit an ulp above the limit; storage
-        // clamps each component to the limit anyway.
-        let mut v = [0.0, 300.0, 0.0];
-        assert_eq!(clamp(&mut v, 127.0), Some(90_000.0));
-        assert!(v[0] == 0.0 && v[2] == 0.0 && (v[1] - 127.0).abs() <= 127.0 * f32::EPSILON, "{v:?}");
     }
 }

@@ -20,6 +20,41 @@ pub(crate) type StepDescription<'a> = &'a Description;
 #[cfg(not(feature = "small-step"))]
 pub(crate) type StepDescription<'a> = Description;
 
+/// A mass class as a step's blocks read it, converted from its mass once a
+/// step (M1c). Laid out without padding: the classes of a world of masses
+/// lie in its memory ([`mass_plane`](crate::storage::layout::mass_plane)).
+#[derive(Clone, Copy, Default)]
+#[repr(C)]
+pub(crate) struct Class {
+    /// M1c's `K = quot(dt, m)`: the velocity, in unit speeds, a unit of
+    /// force adds in a step. A force's push is its exact product with this
+    /// and `W`, rounded.
+    pub push: f32,
+    /// M1c's `M`: the mass relative to the largest in use, `2^24` for that
+    /// one (at least 1), from which a collision takes the shares.
+    pub relative: u32,
+    /// Units of the clamp's energy counter a fine unit squared of speed
+    /// removed is worth: `m 2^31 / W^2` (M5.5, M10), by [`quot`](crate::rules::fixed::quot).
+    pub energy: f32,
+    /// Unused: brings `swirl` to its alignment.
+    pub spare: u32,
+    /// The vortex's strength as a push for this class (M1c's `Γ'`), 0
+    /// without a vortex.
+    pub swirl: i64,
+}
+
+impl Shared<'_> {
+    /// The class of mass index `i`: the first where the index names none
+    /// (no index an API call writes does; an image's are checked).
+    #[inline(always)]
+    pub(crate) fn class(&self, i: u8) -> Class {
+        match self.classes.get(usize::from(i)) {
+            Some(c) => *c,
+            None => self.one,
+        }
+    }
+}
+
 /// What every block of a step reads and none writes.
 pub(crate) struct Shared<'a> {
     pub desc: StepDescription<'a>,
@@ -28,13 +63,23 @@ pub(crate) struct Shared<'a> {
     pub key: StepKey,
     pub obstacle: &'a [u64],
     pub surface: &'a [Surface],
-    pub mass_table: &'a [f32],
+    /// The mass classes in use, converted for this step (M1c): at least
+    /// one; a world of one mass reads entry 0.
+    pub classes: &'a [Class],
+    /// `classes[0]`, the class of every particle of a world of one mass,
+    /// where the lean routines read it without a bounds check.
+    pub one: Class,
     pub terms: ForceTerms<'a>,
-    /// The uniform force's velocity change per step in quanta, where it
-    /// changes anything (the general force path includes it in `terms`).
-    pub push: Option<[f32; 3]>,
-    /// `dt * SCALE`: turns an acceleration into quanta per step.
-    pub dt_q: f32,
+    /// The uniform force's velocity change per step in fine units (M1c's
+    /// `G`), where it changes anything (the general force path includes it
+    /// in `terms`).
+    pub push: Option<[i64; 3]>,
+    /// `push` where every component is below `2^29`, so that a velocity
+    /// and the push add up within the bound in 32 bits: what the lean
+    /// routines add (a world whose push is larger is not plain).
+    pub lean_push: Option<[i32; 3]>,
+    /// M5.2's restitution in Q16 (M1c's `E`).
+    pub restitution: i32,
     /// M5.1b flow drag, where its rate is not 0.
     pub drag: Option<Flow<'a>>,
     /// The 8-bit move table of the drift rule (M5.3).
@@ -90,26 +135,26 @@ pub(crate) struct Block<const D: usize, const CELLS: usize> {
     /// read.
     pub(crate) v: [[i32; D]; CELLS],
     /// Cells whose velocity a stage changed and that await their rounding:
-    /// the velocity is `x[c]`, in quanta.
+    /// the velocity is `x[c]`, in fine units (M1c).
     pub(crate) pending: u8,
-    pub(crate) x: [[f32; 3]; CELLS],
+    pub(crate) x: [[i32; 3]; CELLS],
     /// Cells whose velocity differs from what the plane holds.
     pub(crate) dirty: u8,
 }
 
 impl<const D: usize, const CELLS: usize> Block<D, CELLS> {
-    /// The velocity of the particle in cell `c`, in quanta. Out of line
-    /// with `small-step`: one copy for every stage (less flash, a call a
-    /// read).
+    /// The velocity of the particle in cell `c`, in fine units of
+    /// `2^-fine` quanta (M1c). Out of line with `small-step`: one copy for
+    /// every stage (less flash, a call a read).
     #[cfg_attr(feature = "small-step", inline(never))]
     #[cfg_attr(not(feature = "small-step"), inline(always))]
-    pub(crate) fn velocity(&self, c: usize) -> [f32; 3] {
+    pub(crate) fn velocity(&self, c: usize, fine: u32) -> [i32; 3] {
         if self.pending >> c & 1 != 0 {
             return self.x[c];
         }
-        let mut x = [0.0; 3];
+        let mut x = [0; 3];
         for k in 0..D {
-            x[k] = self.v[c][k] as f32;
+            x[k] = self.v[c][k] << fine;
         }
         x
     }
@@ -118,7 +163,7 @@ impl<const D: usize, const CELLS: usize> Block<D, CELLS> {
     /// Out of line with `small-step`, as [`Block::velocity`] is.
     #[cfg_attr(feature = "small-step", inline(never))]
     #[cfg_attr(not(feature = "small-step"), inline(always))]
-    pub(crate) fn set(&mut self, c: usize, x: [f32; 3]) {
+    pub(crate) fn set(&mut self, c: usize, x: [i32; 3]) {
         self.x[c] = x;
         self.pending |= 1 << c;
     }
@@ -180,3 +225,19 @@ macro_rules! each_cell {
     }};
 }
 pub(crate) use each_cell;
+
+/// Runs `$body` for each cell `$c` set in `$occ` (of a block of `$cells`
+/// cells): unrolled as [`each_cell`] where `$unroll`, else a loop over the
+/// set cells, which is a little slower and far smaller.
+macro_rules! each_occupied {
+    ($unroll:expr, $cells:expr, $occ:expr, $c:ident => $body:block) => {{
+        if $unroll {
+            $crate::step::block::each_cell!($cells, $c => {
+                if $occ >> $c & 1 != 0 $body
+            });
+        } else {
+            for $c in $crate::step::block::cells_of($occ) $body
+        }
+    }};
+}
+pub(crate) use each_occupied;

@@ -1,7 +1,7 @@
 //! The emitters' part of a step (M6): each emitter, in the order they
 //! were added, places its particles before any block of the step.
 
-use crate::rules::emitter::{floor_rate, spread_velocity, Emitter, Slot};
+use crate::rules::emitter::{spread_velocity, split_rate, Emitter, Slot};
 use crate::rules::rng::StepKey;
 use crate::storage::layout::{Grid, Site};
 use crate::storage::world::World;
@@ -10,14 +10,15 @@ impl World {
     /// Runs every emitter once (M6), at the start of a step.
     pub(crate) fn emit(&mut self) {
         let (seed, step, dim) = (self.head.desc.seed, self.head.step, self.dim());
+        let unit = crate::rules::quant::unit_of(self.head.desc.quantization);
         let key = StepKey::emitters(seed, step);
         for i in 0..self.head.emitters as usize {
             let slot: Slot = self.slots()[i];
             let e = slot.emitter;
             let mut rng = key.stream(i as u64);
-            let whole = floor_rate(e.rate);
-            // Casting saturates, so an absurd rate asks for u64::MAX.
-            let wanted = crate::rules::vector::saturating_u64(whole).saturating_add(u64::from(rng.chance(e.rate - whole)));
+            // An absurd rate asks for u64::MAX.
+            let (whole, threshold) = split_rate(e.rate);
+            let wanted = whole.saturating_add(u64::from(rng.bits(24) < threshold));
             if wanted == 0 {
                 continue;
             }
@@ -41,7 +42,7 @@ impl World {
                 left -= 1;
                 if take {
                     need -= 1;
-                    let v = spread_velocity(&e, dim, &mut rng);
+                    let v = spread_velocity(&e, dim, unit, &mut rng);
                     w.place_emitted(s, v, slot.mass_index as u8, e.lifetime as u16, &mut rng);
                 }
             };

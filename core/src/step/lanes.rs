@@ -9,10 +9,9 @@
 use crate::rules::collision::pick_pair;
 use crate::rules::quant::Quant;
 use crate::rules::rng::Stream;
-use crate::rules::vector::dot;
 use crate::step::block::{cells_of, each_cell};
 use crate::step::clamp::clamp_counted;
-use crate::step::kernel::{per_cell, Kernel, BLOCKED_KEY_2D, FIELDS, IDENTITY, KEY_2D_WANTS};
+use crate::step::kernel::{per_cell, pushed_small, stored_speed2, Kernel, BLOCKED_KEY_2D, FIELDS, IDENTITY, KEY_2D_WANTS};
 use crate::step::partition::BlockRow;
 use crate::storage::layout::mark;
 
@@ -58,11 +57,12 @@ fn inward_lanes(lanes: u64, occ: u8) -> u8 {
     ((inward >> 7).wrapping_mul(0x0102_0408_1020_4080) >> 56) as u8
 }
 
-/// Cell `c`'s velocity from a 2D block's byte lanes, in quanta.
+/// Cell `c`'s velocity from a 2D block's byte lanes, in fine units of
+/// `2^-fine` quanta (M1c).
 #[inline(always)]
-fn lane_quanta(lanes: u64, c: usize) -> [f32; 3] {
+fn lane_fine(lanes: u64, c: usize, fine: u32) -> [i32; 3] {
     let [x, y] = lane_ints(lanes, c);
-    [f32::from(x), f32::from(y), 0.0]
+    [i32::from(x) << fine, i32::from(y) << fine, 0]
 }
 
 /// Cell `c`'s stored velocity in byte lanes, as integers: bytes `2c` and
@@ -101,17 +101,17 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
     /// of line: most blocks of most steps need neither.
     #[inline(never)]
     pub(crate) fn change_lanes(&mut self, mut lanes: u64, occ: u8, pair: Option<(usize, usize)>, rng: &mut Stream) -> (u64, u8) {
-        let mass = self.shared.desc.mass;
+        let class = &self.shared.one;
         // Cell c's lanes replaced by the rounding of x (M1).
-        let round_into = |lanes: u64, c: usize, x: [f32; 3], rng: &mut Stream| {
+        let round_into = |lanes: u64, c: usize, x: [i32; 3], rng: &mut Stream| {
             with_lane_ints(lanes, c, Q::round::<2>(x, rng).map(|q| Q::from_int(q).to_int()))
         };
-        if self.shared.push.is_none() {
+        if self.shared.lean_push.is_none() {
             // The collision alone: its two results rounded in cell order
             // (a < c in every pair), as the loop below would.
             let Some((a, c)) = pair else { return (lanes, 0) };
             debug_assert!(a < c);
-            let Some((xa, xc)) = self.collide_two(lane_quanta(lanes, a), lane_quanta(lanes, c), (mass, mass), true, rng) else {
+            let Some((xa, xc)) = self.collide_two(lane_fine(lanes, a, Q::FINE), lane_fine(lanes, c, Q::FINE), (*class, *class), true, rng) else {
                 return (lanes, 0);
             };
             // The four components together: 32 bits for a, then 32 for c.
@@ -122,21 +122,19 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
             lanes = with_lane_ints(with_lane_ints(lanes, a, [q[0], q[1]]), c, [q[2], q[3]]);
             return (lanes, 1 << a | 1 << c);
         }
-        let mut x = [[0.0f32; 3]; CELLS];
+        let mut x = [[0i32; 3]; CELLS];
         let mut pending = 0u8;
-        if let Some(dv) = self.shared.push {
+        if let Some(dv) = self.shared.lean_push {
             for c in cells_of(occ) {
-                let mut y = lane_quanta(lanes, c);
-                y[0] += dv[0];
-                y[1] += dv[1];
-                clamp_counted::<D>(&mut y, Q::SCALE, mass, &mut self.counters);
+                let mut y = pushed_small(lane_fine(lanes, c, Q::FINE), dv);
+                clamp_counted::<D>(&mut y, Q::UNIT, class, &mut self.counters);
                 x[c] = y;
             }
             pending = occ;
         }
         if let Some((a, c)) = pair {
-            let get = |c: usize| if pending >> c & 1 != 0 { x[c] } else { lane_quanta(lanes, c) };
-            if let Some(pair) = self.collide_two(get(a), get(c), (mass, mass), true, rng) {
+            let get = |c: usize| if pending >> c & 1 != 0 { x[c] } else { lane_fine(lanes, c, Q::FINE) };
+            if let Some(pair) = self.collide_two(get(a), get(c), (*class, *class), true, rng) {
                 (x[a], x[c]) = pair;
                 pending |= 1 << a | 1 << c;
             }
@@ -174,7 +172,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
         let mut rng = sh.key.stream(index);
         let pair = pick_pair::<D>(occ, &mut rng);
         let mut pending = 0u8;
-        if sh.push.is_some() || pair.is_some() {
+        if sh.lean_push.is_some() || pair.is_some() {
             (lanes, pending) = self.change_lanes(lanes, occ, pair, &mut rng);
         }
 
@@ -237,7 +235,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
         let mut per_cell = [0u8; CELLS];
         per_cell[..4].copy_from_slice(&wants);
         let key = 2 * usize::from(BLOCKED_KEY_2D[usize::from(occ)]) + usize::from(KEY_2D_WANTS[usize::from(want)]);
-        let targets = self.assign(occ, |c| { let x = lane_quanta(lanes, c); dot(x, x) }, 0, &per_cell, key, rng);
+        let targets = self.assign(occ, |c| { let [x, y] = lane_ints(lanes, c); stored_speed2([i32::from(x), i32::from(y)]) }, 0, &per_cell, key, rng);
         if (targets ^ IDENTITY) & FIELDS[usize::from(occ)] == 0 {
             return self.write_rows(row, x0, lanes, pending);
         }

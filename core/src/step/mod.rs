@@ -20,15 +20,17 @@ pub(crate) mod reflection;
 #[cfg(target_has_atomic = "8")]
 pub(crate) mod tasks;
 
-use crate::rules::force::{Flow, ForceTerms};
+
+use crate::rules::fixed::{divr, magnitude, quot, scaled, scaled_by, to_fine, unit_scale};
+use crate::rules::force::{Flow, ForceTerms, Swirl};
 use crate::rules::quant::Quant;
 use crate::rules::rng::StepKey;
-use crate::step::block::{Shared, Writable};
+use crate::step::block::{Class, Shared, Writable};
 use crate::step::kernel::Kernel;
 use crate::step::partition::Partition;
 use crate::storage::cells::Cells;
 use crate::storage::layout::Layout;
-use crate::storage::layout::{groups, view, Planes};
+use crate::storage::layout::{groups, masses_and_classes, view, Planes};
 #[cfg(target_has_atomic = "8")]
 use crate::step::tasks::Host;
 use crate::storage::world::{Counters, World};
@@ -173,17 +175,18 @@ impl World {
     ) {
         // The shared data read where `setup` wrote it (moved out, it would
         // be a copy of all of it).
-        let s = self.setup(route, Q::SCALE);
+        let s = self.setup(route, Q::UNIT);
         let velocity = Cells::new(groups(view::<Q>(s.velocity)));
         let planes = Writable { occupancy: s.occupancy, rows: s.rows, words: s.words, velocity, mass_index: s.mass_index, life: s.life };
         let c = visit(&s.shared, planes, route.reverse);
         count_step(s.counters, &c, s.shared.part.total_blocks());
     }
 
-    /// A step's [`Setup`] for a velocity width of `scale` quanta per unit
-    /// speed. Out of line: one copy serves every width and dimension.
+    /// A step's [`Setup`] for a velocity width of `unit` fine units per
+    /// unit speed (M1c). Out of line: one copy serves every width and
+    /// dimension.
     #[inline(never)]
-    fn setup(&mut self, route: Route, scale: f32) -> Setup<'_> {
+    fn setup(&mut self, route: Route, unit: i32) -> Setup<'_> {
         let part = Partition::new(self.layout(), &self.head.desc.boundary, self.dim(), self.head.step);
         // Read by the potential's gradient alone, which only `fields` has.
         let periodic = if cfg!(feature = "fields") { self.periodic() } else { [false; 3] };
@@ -202,21 +205,44 @@ impl World {
         let Layout { n, .. } = head.layout;
         let Planes { occupancy, rows, words, obstacle, velocity, mass_index, life, field, potential, wind, mass_table, surface, .. } = p;
         let forces = desc.built_forces();
+        // M1c: every setting converted once, here, by integer arithmetic on
+        // the floats' bits, with W = S 2^F (S odd).
+        let (s, fine) = unit_scale(unit);
         let terms = ForceTerms {
-            gravity: if forces.uniform { desc.gravity } else { [0.0; 3] },
+            gravity: if forces.uniform { desc.gravity.map(|g| scaled_by(desc.dt, g, s, fine)) } else { [0; 3] },
             field: forces.field.then_some(&*field),
             potential: forces.potential.then_some(&*potential),
-            vortex: forces.vortex.then_some(desc.vortex),
+            vortex: forces.vortex.then(|| Swirl::of(&desc.vortex)),
+            unit: (s, fine),
             n,
             periodic,
             dim,
         };
-        let dt_q = desc.dt * scale;
-        let push = terms.gravity.map(|g| if dt_q == 0.0 { 0.0 } else { g * dt_q });
+        let push = terms.gravity;
+        // The classes of the table's masses in use, in its plane (its first
+        // is the world's mass); a world of one mass has none, only `one`.
+        let classes: &[Class] = if desc.has_masses() && head.masses > 0 {
+            let (table, classes) = masses_and_classes(mass_table, desc.mass_classes as usize);
+            let n = (head.masses as usize).min(classes.len());
+            convert_classes(&table[..n], desc.dt, (s, fine), terms.vortex, &mut classes[..n])
+        } else {
+            &[]
+        };
+        let one = match classes.first() {
+            Some(c) => *c,
+            None => convert_class(magnitude(desc.mass), magnitude(desc.mass), desc.dt, (s, fine), terms.vortex),
+        };
         // Fields, potentials, the vortex and drag are summed per particle;
         // a uniform force alone is one precomputed change (`push`).
         let summed = forces.any_field() || desc.has_drag();
-        let plain = route.lean && !desc.has_masses() && !desc.lifetimes && !summed;
+        let small_push = push.iter().all(|g| g.unsigned_abs() < 1 << 29);
+        // Component by component: an array comparison is a `memcmp` call on
+        // small cores.
+        let pushes = push[0] | push[1] | push[2] != 0;
+        // With `small-step` every block takes the general routine: nothing
+        // is plain, and nothing the lean routines read is set up.
+        let lean = !cfg!(feature = "small-step") && route.lean;
+        let plain = lean && !desc.has_masses() && !desc.lifetimes && !summed && small_push;
         let shared = Shared {
             #[cfg(feature = "small-step")]
             desc,
@@ -228,17 +254,22 @@ impl World {
             obstacle,
             // A build without obstacles has no surface entry to slice.
             surface: if cfg!(feature = "obstacles") { &surface[..head.surfaces as usize] } else { &[] },
-            mass_table,
-            push: crate::rules::vector::nonzero(push).then_some(push),
+            one,
+            classes,
+            push: pushes.then_some(push),
+            lean_push: if lean && small_push && pushes { Some(push.map(|g| g as i32)) } else { None },
+            restitution: scaled(desc.restitution, 1.0, 16) as i32,
             terms,
-            dt_q,
             drag: desc.has_drag().then(|| Flow {
-                wind: desc.drag.wind.map(|w| w * scale),
+                wind: desc.drag.wind.map(|u| to_fine(u, (s, fine))),
                 field: desc.drag.field.then_some(&*wind),
-                vortex: desc.drag.vortex.then_some(desc.vortex),
-                scale,
+                vortex: desc.drag.vortex.then(|| {
+                    let swirl = Swirl::of(&desc.vortex);
+                    (swirl, swirl.gamma(1.0, (s, fine)))
+                }),
+                unit: (s, fine),
                 dim,
-                rate: desc.dt * desc.drag.rate,
+                keep: divr(1 << 48, (1 << 32) + scaled(desc.dt, desc.drag.rate, 32) as u64) as i32,
             }),
             moves: crate::rules::quant::move_table_8(desc.drift),
             #[cfg(not(feature = "small-step"))]
@@ -257,6 +288,33 @@ impl World {
             mass_index: Cells::new(mass_index),
             life: Cells::new(life),
         }
+    }
+}
+
+/// The mass classes `masses` (the table's used entries, or the world's one
+/// mass, at least one) converted for a step of `dt` in a world of
+/// `W = S 2^F` fine units to a unit speed, `(s, fine) = (S, F)` (M1c), into
+/// `out`, one entry a class: `K`, the relative mass, the clamp's energy
+/// factor and the vortex's push.
+fn convert_classes<'a>(masses: &[f32], dt: f32, scale: (u32, i32), swirl: Option<Swirl>, out: &'a mut [Class]) -> &'a [Class] {
+    // Masses are positive (checked): their bits order them as numbers.
+    let largest = magnitude(f32::from_bits(masses.iter().fold(0, |a, &m| a.max(m.to_bits()))));
+    for (slot, &m) in out.iter_mut().zip(masses) {
+        *slot = convert_class(magnitude(m), largest, dt, scale, swirl);
+    }
+    out
+}
+
+/// The class of mass `m` (`(m, e)`, [`magnitude`]) where `largest` is the
+/// largest mass in use: [`convert_classes`] for one class.
+fn convert_class(m: (u32, i32), largest: (u32, i32), dt: f32, (s, fine): (u32, i32), swirl: Option<Swirl>) -> Class {
+    let push = quot(magnitude(dt), m, 0);
+    Class {
+        push,
+        relative: (scaled(quot(m, largest, 0), 1.0, 24) as u32).max(1),
+        energy: quot(magnitude(quot(m, (s, 0), 0)), (s, 0), 31 - 2 * fine),
+        spare: 0,
+        swirl: swirl.map_or(0, |v| v.gamma(push, (s, fine))),
     }
 }
 

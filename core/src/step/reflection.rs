@@ -4,21 +4,23 @@
 //! through.
 
 use crate::api::desc::Boundary;
+use crate::rules::collision::WIDEST;
 use crate::rules::faces::{resolve, Beyond, Coords};
-use crate::rules::obstacle::{reflect, surface_at, Surface};
-use crate::rules::vector::{dot, normalise};
-use crate::step::block::Shared;
+use crate::rules::fixed::scaled;
+use crate::rules::obstacle::{axis_q30, dot_q30, normal_q30, reflect, surface_at, Surface};
+use crate::step::block::{Class, Shared};
 use crate::step::clamp::clamp_counted;
 use crate::storage::layout::{row_words, test_bit};
 use crate::storage::world::Counters;
 
-/// A unit normal from cell `to` back towards cell `from` of the same block.
-pub(crate) fn back_normal<const D: usize>(from: usize, to: usize) -> [f32; 3] {
-    let mut n = [0.0f32; 3];
+/// The unit normal from cell `to` back towards cell `from` of the same
+/// block, in Q30 (M1c).
+pub(crate) fn back_normal<const D: usize>(from: usize, to: usize) -> [i32; 3] {
+    let mut n = [0; 3];
     for k in 0..D {
-        n[k] = ((from >> k) & 1) as f32 - ((to >> k) & 1) as f32;
+        n[k] = ((from >> k) & 1) as i32 - ((to >> k) & 1) as i32;
     }
-    normalise(n).unwrap_or([0.0; 3])
+    axis_q30(n)
 }
 
 /// A blocked cell a particle wants (M5.4): its number in the block, its
@@ -32,21 +34,28 @@ pub(crate) struct Wanted {
     pub(crate) wall: bool,
 }
 
-/// M5.4: the particle in cell `c` of mass `m`, with velocity `x` (in
-/// quanta, `scale` to a unit speed), wants the blocked cell `to`: its
-/// velocity reflected off that cell's surface (eq. 9) and clamped, or `None`
-/// where the surface says the particle is already leaving and it keeps its
-/// velocity. Either way the caller keeps the particle in its cell this step.
-/// Rare, so kept out of the block routine's straight line, and the same
-/// code for both velocity widths.
+/// M5.4: the particle in cell `c` of class `class`, with velocity `x` (in
+/// fine units, `unit` to a unit speed), wants the blocked cell `to`: its
+/// velocity reflected off that cell's surface (eq. 9, M1c) and clamped, or
+/// `None` where the surface says the particle is already leaving and it
+/// keeps its velocity. Either way the caller keeps the particle in its
+/// cell this step. Rare, so kept out of the block routine's straight line,
+/// and one copy for both velocity widths and both dimensions (`dim`), in
+/// the build's widest ([`WIDEST`]): in 2D the third component is set to 0
+/// first, which no 2D stage reads and no 2D normal has, so the 3D
+/// arithmetic below is the 2D rule.
 #[cold]
 #[inline(never)]
-pub(crate) fn reflect_off<const D: usize>(sh: &Shared<'_>, x: [f32; 3], c: usize, to: Wanted, m: f32, scale: f32, counters: &mut Counters) -> Option<[f32; 3]> {
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn reflect_off(sh: &Shared<'_>, mut x: [i32; 3], c: usize, to: Wanted, class: &Class, unit: i32, counters: &mut Counters, dim: usize) -> Option<[i32; 3]> {
+    if WIDEST == 3 && dim == 2 {
+        x[2] = 0;
+    }
     let t = to.cell;
     let mut surface = None;
     if to.wall {
         if let Beyond::Wall(n) = resolve(sh.n, &sh.desc.boundary, to.at) {
-            surface = Some((n, sh.desc.wall_restitution));
+            surface = Some((axis_q30(n), sh.desc.wall_restitution));
         }
     }
     // A build without obstacles has no surface entry and no obstacle
@@ -56,22 +65,22 @@ pub(crate) fn reflect_off<const D: usize>(sh: &Shared<'_>, x: [f32; 3], c: usize
         // Component by component: a copy of the array through the
         // reference is a `memmove` call at opt-level z, the only one in a
         // firmware build.
-        Some(s) => ([s.normal[0], s.normal[1], s.normal[2]], s.restitution),
+        Some(s) => (normal_q30([s.normal[0], s.normal[1], s.normal[2]]), s.restitution),
         // Unreachable for obstacles added through the API (every cell
         // next to a free one has an entry): the direction back to the
         // particle.
-        None if cfg!(feature = "obstacles") => (back_normal::<D>(c, t), sh.desc.wall_restitution),
+        None if cfg!(feature = "obstacles") => (back_normal::<WIDEST>(c, t), sh.desc.wall_restitution),
         // Unreachable without obstacles: only cells beyond a wall are
         // blocked then, and `resolve` gave their surface above. A normal
         // of 0 would reflect nothing; the build holds no code for the
         // direction back.
-        None => ([0.0; 3], sh.desc.wall_restitution),
+        None => ([0; 3], sh.desc.wall_restitution),
     });
     // Without obstacles only cells beyond a wall face are blocked, and a
     // particle asks for one only moving towards it (M5.3: every axis it
     // crosses points out of the domain), so N.v < 0: a build without
     // obstacles leaves out the case below (the tests check the claim).
-    let n = if !cfg!(feature = "obstacles") || dot(x, n) < 0.0 {
+    let n = if !cfg!(feature = "obstacles") || dot_q30(x, n) < 0 {
         n
     } else {
         // The particle already leaves the surface (N.v >= 0), yet asks
@@ -85,17 +94,17 @@ pub(crate) fn reflect_off<const D: usize>(sh: &Shared<'_>, x: [f32; 3], c: usize
         // mask corner), it would press on the obstacle for ever: reflect
         // off the face it came through. M5.4.
         let mut at = to.at;
-        for (k, a) in at.iter_mut().enumerate().take(D) {
+        for (k, a) in at.iter_mut().enumerate().take(dim) {
             *a += ((c >> k) & 1) as isize - ((t >> k) & 1) as isize;
         }
-        let back = back_normal::<D>(c, t);
-        if dot(n, back) > 0.0 && axis_move_free(if cfg!(feature = "obstacles") { sh.obstacle } else { &[] }, sh.n, &sh.desc.boundary, at, x, D) {
+        let back = back_normal::<WIDEST>(c, t);
+        if dot_q30(n, back) > 0 && axis_move_free(if cfg!(feature = "obstacles") { sh.obstacle } else { &[] }, sh.n, &sh.desc.boundary, at, x, dim) {
             return None;
         }
         back
     };
-    let mut x = reflect(x, n, e); // eq. 9
-    clamp_counted::<D>(&mut x, scale, m, counters);
+    let mut x = reflect(x, n, scaled(e, 1.0, 16) as i32); // eq. 9
+    clamp_counted::<WIDEST>(&mut x, unit, class, counters);
     Some(x)
 }
 
@@ -105,13 +114,13 @@ pub(crate) fn reflect_off<const D: usize>(sh: &Shared<'_>, x: [f32; 3], c: usize
 /// `sign(v_k)`, `v_k != 0`, one of the first `dim` axes) that is neither an
 /// obstacle (bit plane `obstacle`) nor beyond a wall. Such a particle can
 /// always move on later, so refusing it one move leaves it never stuck.
-pub(crate) fn axis_move_free(obstacle: &[u64], n: [usize; 3], boundary: &[[Boundary; 2]; 3], at: Coords, v: [f32; 3], dim: usize) -> bool {
+pub(crate) fn axis_move_free(obstacle: &[u64], n: [usize; 3], boundary: &[[Boundary; 2]; 3], at: Coords, v: [i32; 3], dim: usize) -> bool {
     (0..dim).any(|k| {
-        if v[k] == 0.0 {
+        if v[k] == 0 {
             return false;
         }
         let mut to = at;
-        to[k] += if v[k] > 0.0 { 1 } else { -1 };
+        to[k] += if v[k] > 0 { 1 } else { -1 };
         match resolve(n, boundary, to) {
             Beyond::Wall(_) => false,
             Beyond::Open => true,

@@ -10,6 +10,7 @@ use crate::Error;
 use crate::api::desc::{Description, Quantization};
 use crate::rules::emitter::Slot;
 use crate::rules::obstacle::Surface;
+use crate::step::block::Class;
 use crate::storage::cells::Cells;
 
 /// Marks plain data that any bit pattern makes valid, so planes of it can be
@@ -33,6 +34,9 @@ unsafe impl<T: Plain, const N: usize> Plain for [T; N] {}
 unsafe impl Plain for Surface {}
 // SAFETY: u32 and f32 fields only, no padding, every bit pattern valid.
 unsafe impl Plain for Slot {}
+// SAFETY: f32, u32, f32, u32 and i64 fields in that order (`repr(C)`), no
+// padding, every bit pattern valid.
+unsafe impl Plain for Class {}
 
 /// Views a plane of `T` as whole groups of `N` (a cell's `N` velocity
 /// components, say); a partial group at the end is left out.
@@ -215,7 +219,7 @@ impl Layout {
             per_cell(dim * 4, d.forces.field)?,
             per_cell(4, d.forces.potential)?,
             per_cell(dim * 4, d.drag.field)?,
-            if d.per_particle_mass { d.mass_classes as usize * 4 } else { 0 },
+            if d.per_particle_mass { mass_plane(d.mass_classes as usize) } else { 0 },
             mul(d.surface_capacity as usize * usize::from(d.obstacles), size_of::<crate::rules::obstacle::Surface>())?,
             mul(d.emitter_capacity as usize, size_of::<crate::rules::emitter::Slot>())?,
         ];
@@ -242,6 +246,26 @@ impl Description {
     }
 }
 
+/// The bytes of the mass table's plane for `n` classes: the masses (`f32`),
+/// padded to 8 bytes, then the step's conversion of each class (M1c),
+/// scratch the step writes before it reads: in the world's memory rather
+/// than on a stack a small core may not have room for, and no part of the
+/// world's state (snapshots save the masses alone).
+pub(crate) const fn mass_plane(n: usize) -> usize {
+    (n * 4).next_multiple_of(8) + n * size_of::<Class>()
+}
+
+/// The mass table's plane `plane` of a world of `n` classes split into the
+/// masses and the step's classes ([`mass_plane`]).
+pub(crate) fn masses_and_classes(plane: &mut [f32], n: usize) -> (&mut [f32], &mut [Class]) {
+    let (table, rest) = plane.split_at_mut(n.next_multiple_of(2));
+    // SAFETY: f32 and Class accept every bit pattern (Plain), the bytes
+    // are those of `rest`, borrowed as long, and `view` checks the
+    // alignment (the classes start 8-aligned: `mass_plane`).
+    let bytes = unsafe { core::slice::from_raw_parts_mut(rest.as_mut_ptr().cast::<u8>(), rest.len() * 4) };
+    (&mut table[..n], view(bytes))
+}
+
 /// `a * b`, or `TooLarge` where it overflows. Out of line: one copy for
 /// every size [`Layout::of`] checks.
 #[inline(never)]
@@ -261,6 +285,8 @@ pub(crate) struct Planes<'a, Q> {
     pub field: &'a mut [f32],
     pub potential: &'a mut [f32],
     pub wind: &'a mut [f32],
+    /// The masses, then the step's classes ([`mass_plane`]), viewed as
+    /// `f32`: [`masses_and_classes`] splits them.
     pub mass_table: &'a mut [f32],
     pub surface: &'a mut [Surface],
     pub emitters: &'a mut [Slot],

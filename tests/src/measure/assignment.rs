@@ -35,7 +35,7 @@ pub fn problems(dim: u32, k: usize, count: usize, seed: u64) -> Vec<MoveProblem>
                     }
                 }
                 p.desired[i] = want;
-                p.speed2[i] = rng.unit();
+                p.speed2[i] = rng.below(1 << 16);
             }
             p
         })

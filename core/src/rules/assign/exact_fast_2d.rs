@@ -47,7 +47,7 @@ fn table_key(problem: &MoveProblem, free: u8, count: usize) -> usize {
 
 /// The block a table key stands for, particles in increasing cell order.
 pub(super) const fn decode_key(key: usize) -> MoveProblem {
-    let mut problem = MoveProblem { free: 0, count: 0, current: [0; MAX_CELLS], desired: [0; MAX_CELLS], speed2: [0.0; MAX_CELLS] };
+    let mut problem = MoveProblem { free: 0, count: 0, current: [0; MAX_CELLS], desired: [0; MAX_CELLS], speed2: [0; MAX_CELLS] };
     let mut cell = 0;
     while cell < CELLS_2D {
         let d = key / PLACE_2D[cell] as usize % 6;

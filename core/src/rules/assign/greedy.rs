@@ -59,8 +59,8 @@ mod tests {
         let mut rng = block_stream(4, 0, 0);
         for fast in 0..2 {
             let mut problem = block(0xff, &[1, 2], &[0, 0]);
-            problem.speed2[fast] = 0.5;
-            problem.speed2[1 - fast] = 0.25;
+            problem.speed2[fast] = 2;
+            problem.speed2[1 - fast] = 1;
             let a = assign_moves::<3>(Method::Greedy, &problem, &mut rng);
             assert_eq!(a.target[fast], 0);
             assert_eq!(a.target[1 - fast], problem.current[1 - fast]);

@@ -90,8 +90,9 @@ pub struct MoveProblem {
     pub current: [u8; MAX_CELLS],
     /// Local cell each particle wants.
     pub desired: [u8; MAX_CELLS],
-    /// Squared speed of each particle, for greedy ranking.
-    pub speed2: [f32; MAX_CELLS],
+    /// Squared speed of each particle, for greedy ranking: the step gives
+    /// the exact sum of the squared stored components (M5.6, M1c).
+    pub speed2: [u32; MAX_CELLS],
 }
 
 /// The local cell given to each particle, in the problem's particle order.
@@ -386,7 +387,7 @@ mod tests {
             let mut block = decode_key(key);
             states += 1;
             for i in 0..block.count {
-                block.speed2[i] = rng.below(3) as f32; // ties included
+                block.speed2[i] = rng.below(3); // ties included
             }
             let (best, _) = optimal_set(&block, 4);
             for order in permutations(block.count) {
@@ -414,7 +415,7 @@ mod tests {
             if i < count {
                 problem.current[i] = cell;
                 problem.desired[i] = rng.below(8) as u8;
-                problem.speed2[i] = (rng.below(4) as f32) * 0.25;
+                problem.speed2[i] = rng.below(4);
                 problem.free |= 1 << cell;
             } else if rng.below(4) != 0 {
                 problem.free |= 1 << cell;
