@@ -291,7 +291,7 @@ fn memory_follows_the_scene() {
                 d.mass_classes = 16;
             },
             // The index plane, the table, and the step's conversion of each
-            // class (M1c: 24 bytes a class).
+            // class (M1c).
             cells + 16 * 4 + 16 * 24,
         );
         adds("force field", |d| d.forces.field = true, 4 * d * cells);

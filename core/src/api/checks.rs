@@ -6,7 +6,7 @@
 use crate::Error;
 
 /// Every value finite: an exponent short of all ones (from the bits, as
-/// [`order`] compares).
+/// the comparisons below).
 pub(crate) fn finite(values: &[f32]) -> Result<(), Error> {
     if values.iter().all(|v| v.to_bits() & 0x7f80_0000 != 0x7f80_0000) { Ok(()) } else { Err(Error::NotFinite) }
 }

@@ -157,6 +157,14 @@ impl World {
     }
 }
 
+/// A velocity as [`World::place`] takes it: a caller's floats (rounded to
+/// nearest), or an emitter's fine units (rounded stochastically, M1c).
+#[derive(Clone, Copy)]
+enum Velocity {
+    Float([f32; 3]),
+    Fine([i32; 3]),
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -202,12 +210,4 @@ mod tests {
         assert_eq!(w.add_particle([1, 1, 0], [1.0001, 0.0, 0.0]), Err(Error::SpeedRange));
         assert_eq!(w.add_particle([1, 1, 0], [0.8, 0.7, 0.0]), Err(Error::SpeedRange));
     }
-}
-
-/// A velocity as [`World::place`] takes it: a caller's floats (rounded to
-/// nearest), or an emitter's fine units (rounded stochastically, M1c).
-#[derive(Clone, Copy)]
-enum Velocity {
-    Float([f32; 3]),
-    Fine([i32; 3]),
 }

@@ -9,6 +9,7 @@
 //! `storable`), decided in integers.
 
 use crate::api::checks::size;
+use crate::rules::fixed::parts;
 
 /// Whether `u` (1 to 3 finite components, as every caller has checked)
 /// has `|u| <= 1`, exactly: integers decide ([`too_fast`] with no spread),
@@ -76,23 +77,11 @@ pub(crate) fn too_fast(v: [f32; 3], spread: f32) -> bool {
     for &c in &v {
         left.add_square(c);
     }
-    let (m, e) = parts(spread);
+    let (_, m, e) = parts(spread);
     left.add(m, e + 1);
     right.add(1, 0);
     right.add_square(spread);
     left.above(&right)
-}
-
-/// `x = m 2^e` (m below 2^24, e from -149 up) for a finite `x`, its sign
-/// dropped.
-fn parts(x: f32) -> (u64, i32) {
-    let bits = x.to_bits() & 0x7fff_ffff;
-    let (exponent, fraction) = ((bits >> 23) as i32, u64::from(bits & 0x7f_ffff));
-    if exponent == 0 {
-        (fraction, -149) // subnormal
-    } else {
-        (fraction | 1 << 23, exponent - 150)
-    }
 }
 
 /// A number below 2^301 in units of 2^-298 (every `f32` square is a whole
@@ -126,7 +115,7 @@ impl Wide {
 
     /// Adds `x^2`.
     fn add_square(&mut self, x: f32) {
-        let (m, e) = parts(x);
+        let (_, m, e) = parts(x);
         self.add(m * m, 2 * e);
     }
 
@@ -206,7 +195,7 @@ mod tests {
     /// way to the exact answer, for a narrower range.
     fn in_u128(v: [f32; 3], spread: f32) -> Option<bool> {
         let fixed = |x: f32| {
-            let (m, e) = parts(x);
+            let (_, m, e) = parts(x);
             (e >= -54).then(|| u128::from(m) << (e + 54))
         };
         if spread >= 1.0 {
@@ -271,7 +260,7 @@ mod tests {
     fn slow_in_u128(u: &[f32]) -> Option<bool> {
         let mut square = 0u128;
         for &c in u.iter().filter(|&&c| c != 0.0) {
-            let (m, e) = parts(c);
+            let (_, m, e) = parts(c);
             square += (u128::from(m) << (e >= -54).then_some(e + 54)?).pow(2);
         }
         Some(square <= 1 << 108)

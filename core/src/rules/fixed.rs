@@ -52,8 +52,8 @@ pub(crate) fn sq<const D: usize>(x: [i32; 3]) -> u64 {
 
 /// `a / b` rounded down, `b > 0`: every division of the step goes through
 /// here. On 32-bit Arm (no instruction divides 64 bits) by shifting and
-/// subtracting, one quotient bit a round: a few instructions of flash where
-/// the library's routine takes over a kilobyte; elsewhere the instruction.
+/// subtracting, one quotient bit a round: a short loop in flash where the
+/// runtime's routine is long; elsewhere the instruction.
 #[inline]
 pub(crate) fn udiv(a: u64, b: u64) -> u64 {
     if cfg!(target_arch = "arm") { shift_subtract(a, b) } else { a / b }

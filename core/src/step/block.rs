@@ -63,11 +63,12 @@ pub(crate) struct Shared<'a> {
     pub key: StepKey,
     pub obstacle: &'a [u64],
     pub surface: &'a [Surface],
-    /// The mass classes in use, converted for this step (M1c): at least
-    /// one; a world of one mass reads entry 0.
+    /// The mass classes in use in a world of masses, converted for this
+    /// step (M1c); none in a world of one mass, which reads `one`.
     pub classes: &'a [Class],
-    /// `classes[0]`, the class of every particle of a world of one mass,
-    /// where the lean routines read it without a bounds check.
+    /// The class of every particle of a world of one mass (class 0 in a
+    /// world of masses), where the lean routines read it without a bounds
+    /// check.
     pub one: Class,
     pub terms: ForceTerms<'a>,
     /// The uniform force's velocity change per step in fine units (M1c's

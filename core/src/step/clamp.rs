@@ -47,8 +47,8 @@ mod tests {
         // Expect: for random velocities up to the saturation bound, in 2D
         // and 3D, a clamped velocity is at most the limit long, within two
         // fine units per component (the rounded-up length and the floor) of
-        // the limit along the same direction,
-        // and one below the limit is left as it is.
+        // the limit along the same direction, and one below the limit is
+        // left as it is.
         let mut rng = block_stream(31, 0, 0);
         let unit = 127 << 16;
         let class = Class { push: 0.0, relative: 1 << 24, energy: 1.0, swirl: 0, spare: 0 };

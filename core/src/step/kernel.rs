@@ -489,10 +489,10 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
         b.round::<Q>(&mut rng);
         let mut want = [0u8; CELLS];
         let (mut key, mut wanted) = (0, 0u8);
-        // 8-bit velocities: the cells unrolled, so that what depends on a
-        // cell folds at compile time. 16-bit: a loop (here and in the write
-        // back), which keeps a copy of M5.3 for every cell out of the
-        // library.
+        // 8-bit velocities and 2D: the cells unrolled, so that what depends
+        // on a cell folds at compile time. 16-bit 3D: a loop (here and in
+        // the write back), which keeps a copy of M5.3 for each of eight
+        // cells out of the library.
         each_occupied!(Q::LANES || D == 2, CELLS, occ, c => {
             want[c] = self.decide(b.v[c], c, &mut bytes, &mut rng);
             wanted |= want[c];
@@ -732,7 +732,7 @@ mod tests {
     use crate::api::desc::Boundary;
     use crate::rules::faces::Coords;
     use crate::rules::assign::digit;
-    
+
     #[test]
     fn a_wall_is_only_asked_for_against_its_normal() {
         // Expect: where only walls block (no obstacles), a particle whose

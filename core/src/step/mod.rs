@@ -20,7 +20,6 @@ pub(crate) mod reflection;
 #[cfg(target_has_atomic = "8")]
 pub(crate) mod tasks;
 
-
 use crate::rules::fixed::{divr, magnitude, quot, scaled, scaled_by, to_fine, unit_scale};
 use crate::rules::force::{Flow, ForceTerms, Swirl};
 use crate::rules::quant::Quant;
@@ -218,19 +217,19 @@ impl World {
             periodic,
             dim,
         };
-        let push = terms.gravity;
+        let (push, vortex) = (terms.gravity, terms.vortex);
         // The classes of the table's masses in use, in its plane (its first
         // is the world's mass); a world of one mass has none, only `one`.
         let classes: &[Class] = if desc.has_masses() && head.masses > 0 {
             let (table, classes) = masses_and_classes(mass_table, desc.mass_classes as usize);
             let n = (head.masses as usize).min(classes.len());
-            convert_classes(&table[..n], desc.dt, (s, fine), terms.vortex, &mut classes[..n])
+            convert_classes(&table[..n], desc.dt, (s, fine), vortex, &mut classes[..n])
         } else {
             &[]
         };
         let one = match classes.first() {
             Some(c) => *c,
-            None => convert_class(magnitude(desc.mass), magnitude(desc.mass), desc.dt, (s, fine), terms.vortex),
+            None => convert_class(magnitude(desc.mass), magnitude(desc.mass), desc.dt, (s, fine), vortex),
         };
         // Fields, potentials, the vortex and drag are summed per particle;
         // a uniform force alone is one precomputed change (`push`).
@@ -264,7 +263,8 @@ impl World {
                 wind: desc.drag.wind.map(|u| to_fine(u, (s, fine))),
                 field: desc.drag.field.then_some(&*wind),
                 vortex: desc.drag.vortex.then(|| {
-                    let swirl = Swirl::of(&desc.vortex);
+                    // Converted once: the force's where it is on too.
+                    let swirl = vortex.unwrap_or_else(|| Swirl::of(&desc.vortex));
                     (swirl, swirl.gamma(1.0, (s, fine)))
                 }),
                 unit: (s, fine),
@@ -291,8 +291,7 @@ impl World {
     }
 }
 
-/// The mass classes `masses` (the table's used entries, or the world's one
-/// mass, at least one) converted for a step of `dt` in a world of
+/// The mass classes `masses` (the mass table's entries in use) converted for a step of `dt` in a world of
 /// `W = S 2^F` fine units to a unit speed, `(s, fine) = (S, F)` (M1c), into
 /// `out`, one entry a class: `K`, the relative mass, the clamp's energy
 /// factor and the vortex's push.
