@@ -128,8 +128,8 @@ const fn move_table(calibrated: bool) -> [u16; 256] {
 static PAPER_8: [u16; 256] = move_table(false);
 static CALIBRATED_8: [u16; 256] = move_table(true);
 
-/// The high bytes of a move table's entries: what the lanes routine
-/// compares a random byte with first, without the shift.
+/// The high bytes of a move table's entries: what M5.3 compares a random
+/// byte with first for 8-bit velocities, without the shift.
 #[cfg(not(feature = "small-step"))]
 const fn tops(table: &[u16; 256]) -> [u8; 256] {
     let mut t = [0; 256];

@@ -7,14 +7,14 @@ use crate::rules::assign::{bits, Bits};
 use crate::rules::force::{Flow, ForceTerms};
 use crate::rules::obstacle::Surface;
 use crate::rules::quant::Quant;
-use crate::rules::rng::{StepKey, Stream};
-use crate::step::partition::Partition;
+use crate::rules::rng::StepKey;
+use crate::step::partition::{BlockRow, Partition};
 use crate::storage::cells::Cells;
 
 /// The description as a step's blocks read it: with `small-step` where it
 /// lies in the world's header (no copy to set up: less flash, a load more
 /// for each field a block reads), otherwise a copy beside the other
-/// shared data, which the lean routines read without that load.
+/// shared data, which the plain instantiations read without that load.
 #[cfg(feature = "small-step")]
 pub(crate) type StepDescription<'a> = &'a Description;
 #[cfg(not(feature = "small-step"))]
@@ -67,17 +67,18 @@ pub(crate) struct Shared<'a> {
     /// step (M1c); none in a world of one mass, which reads `one`.
     pub classes: &'a [Class],
     /// The class of every particle of a world of one mass (class 0 in a
-    /// world of masses), where the lean routines read it without a bounds
-    /// check.
+    /// world of masses), where the plain instantiations read it without a
+    /// bounds check.
     pub one: Class,
     pub terms: ForceTerms<'a>,
     /// The uniform force's velocity change per step in fine units (M1c's
-    /// `G`), where it changes anything (the general force path includes it
+    /// `G`), where it changes anything (the summed force path includes it
     /// in `terms`).
     pub push: Option<[i64; 3]>,
     /// `push` where every component is below `2^29`, so that a velocity
-    /// and the push add up within the bound in 32 bits: what the lean
-    /// routines add (a world whose push is larger is not plain).
+    /// and the push add up within the bound in 32 bits: what M5.1 adds
+    /// where the force is uniform (a world whose push is larger is not
+    /// plain).
     pub lean_push: Option<[i32; 3]>,
     /// M5.2's restitution in Q16 (M1c's `E`).
     pub restitution: i32,
@@ -85,34 +86,22 @@ pub(crate) struct Shared<'a> {
     pub drag: Option<Flow<'a>>,
     /// The 8-bit move table of the drift rule (M5.3).
     pub moves: &'static [u16; 256],
-    /// The high bytes of `moves`' entries, which the lanes routine reads
-    /// ([`Shared::tops`]; not built with `small-step`, which never calls
-    /// that routine).
+    /// The high bytes of `moves`' entries, which M5.3 reads first for
+    /// 8-bit velocities (`Kernel::crosses`; not built with `small-step`,
+    /// which reads `moves` alone).
     #[cfg(not(feature = "small-step"))]
     pub tops: &'static [u8; 256],
     /// Forces other than a uniform one (fields, potentials, the vortex,
-    /// drag) are summed per particle, in [`Kernel::general`].
+    /// drag) are summed per particle, where the pipeline has every part
+    /// (`kernel::Every`).
     pub summed: bool,
     /// One mass, no lifetimes, no summed force: blocks away from the faces
-    /// and without an obstacle go through [`Kernel::lean`] (or
-    /// [`Kernel::lean_2d`]).
+    /// and without an obstacle take a plain instantiation of the pipeline
+    /// (`kernel::Plain`, or lanes).
     pub plain: bool,
-    /// `plain` without contacts (M5.7): what [`Kernel::lean_2d`] needs of
-    /// the step, tested once a block.
+    /// `plain` without contacts (M5.7): what the lanes representation
+    /// (`lanes::Lanes`) needs of the step, tested once a row.
     pub lanes: bool,
-}
-
-impl Shared<'_> {
-    /// The high bytes of the move table's entries, for the lanes routine.
-    #[inline(always)]
-    pub(crate) fn tops(&self) -> &'static [u8; 256] {
-        #[cfg(not(feature = "small-step"))]
-        return self.tops;
-        // `visit` sends every block to the general routine with
-        // `small-step`: the lanes routine, and this, never run.
-        #[cfg(feature = "small-step")]
-        unreachable!("small-step has no lanes routine")
-    }
 }
 
 /// The planes a step writes; `velocity` holds a cell's `D` components
@@ -128,65 +117,129 @@ pub(crate) struct Writable<'a, Q, const D: usize> {
     pub life: Cells<'a, u16>,
 }
 
-/// A block's particles as the stages of M5 see them.
+/// A block's stored velocities (in quanta) as the pipeline holds them
+/// (M5): per-cell arrays ([`Block`]) or, for the plain 2D block of 8-bit
+/// velocities, one word of byte lanes
+/// ([`Lanes`](crate::step::lanes::Lanes)). The stages read and write a
+/// block through this alone, so each is written once for both.
+pub(crate) trait Stored<const D: usize> {
+    /// Cells holding a particle.
+    fn occ(&self) -> u8;
+    /// Cells whose velocity differs from what the plane holds.
+    fn dirty(&self) -> u8;
+    /// The stored velocity of the particle in cell `c`, in quanta.
+    fn stored(&self, c: usize) -> [i32; D];
+    /// Makes `q` (in quanta, within the stored range) the stored velocity of
+    /// the particle in cell `c`: M1's result.
+    fn put(&mut self, c: usize, q: [i32; D]);
+
+    /// Component `i % D` of the stored velocity of cell `i / D`.
+    #[inline(always)]
+    fn component(&self, i: usize) -> i32 {
+        self.stored(i / D)[i % D]
+    }
+
+    /// M5.3's first test, in 2D: bit `2c + k` set where cell `c` holds a
+    /// particle whose component `k` points inward, across the block's
+    /// middle (positive on the low side of the axis, negative on the high).
+    #[inline(always)]
+    fn inward(&self) -> u8 {
+        let mut inward = 0u8;
+        for c in cells_of(self.occ()) {
+            inward |= inward_axes::<D>(self.stored(c), c) << (D * c);
+        }
+        inward
+    }
+
+    /// The velocity of the particle in cell `c` as stored, in fine units of
+    /// `2^-fine` quanta (M1c).
+    #[inline(always)]
+    fn fine(&self, c: usize, fine: u32) -> [i32; 3] {
+        let q = self.stored(c);
+        let mut x = [0; 3];
+        for k in 0..D {
+            x[k] = q[k] << fine;
+        }
+        x
+    }
+}
+
+/// The axes `k` (bit `k`) along which the particle in cell `c`, of stored
+/// velocity `q`, points inward: towards +k from the low side of the block,
+/// towards -k from the high (M5.3). Only such a move stays inside the
+/// block.
+#[inline(always)]
+pub(crate) fn inward_axes<const D: usize>(q: [i32; D], c: usize) -> u8 {
+    let mut inward = 0u8;
+    for k in 0..D {
+        let low = (c >> k) & 1 == 0;
+        inward |= u8::from(if low { q[k] > 0 } else { q[k] < 0 }) << k;
+    }
+    inward
+}
+
+/// A block's particles as per-cell arrays: the representation of every
+/// block but the plain 2D ones of 8-bit worlds.
 pub(crate) struct Block<const D: usize, const CELLS: usize> {
     /// Cells holding a particle.
     pub(crate) occ: u8,
     /// Velocities as stored, in quanta; what an empty cell holds is never
     /// read.
     pub(crate) v: [[i32; D]; CELLS],
-    /// Cells whose velocity a stage changed and that await their rounding:
-    /// the velocity is `x[c]`, in fine units (M1c).
-    pub(crate) pending: u8,
-    pub(crate) x: [[i32; 3]; CELLS],
     /// Cells whose velocity differs from what the plane holds.
     pub(crate) dirty: u8,
 }
 
 impl<const D: usize, const CELLS: usize> Block<D, CELLS> {
-    /// The velocity of the particle in cell `c`, in fine units of
-    /// `2^-fine` quanta (M1c). Out of line with `small-step`: one copy for
-    /// every stage (less flash, a call a read).
-    #[cfg_attr(feature = "small-step", inline(never))]
-    #[cfg_attr(not(feature = "small-step"), inline(always))]
-    pub(crate) fn velocity(&self, c: usize, fine: u32) -> [i32; 3] {
-        if self.pending >> c & 1 != 0 {
-            return self.x[c];
+    /// The block's stored velocities as per-cell arrays, read a block row
+    /// (two neighbouring cells) at a time where the row does not wrap.
+    #[inline(always)]
+    pub(crate) fn load<Q: Quant>(velocity: Cells<'_, [Q; D]>, row: &BlockRow, xs: [usize; 2], occ: u8) -> Self {
+        let mut b = Block { occ, v: [[0; D]; CELLS], dirty: 0 };
+        // With `small-step` a cell at a time always: one loop, less flash.
+        if !cfg!(feature = "small-step") && xs[1] == xs[0] + 1 {
+            for r in 0..CELLS / 2 {
+                if occ >> (2 * r) & 3 != 0 {
+                    let at = xs[0] + row.cell[r];
+                    let pair = velocity.pair(at);
+                    b.v[2 * r] = ints(pair[0]);
+                    b.v[2 * r + 1] = ints(pair[1]);
+                }
+            }
+        } else {
+            for c in cells_of(occ) {
+                b.v[c] = ints(velocity.get(xs[c & 1] + row.cell[c >> 1]));
+            }
         }
-        let mut x = [0; 3];
-        for k in 0..D {
-            x[k] = self.v[c][k] << fine;
-        }
-        x
+        b
+    }
+}
+
+impl<const D: usize, const CELLS: usize> Stored<D> for Block<D, CELLS> {
+    #[inline(always)]
+    fn occ(&self) -> u8 {
+        self.occ
     }
 
-    /// Makes `x` the velocity of the particle in cell `c`, to be rounded.
-    /// Out of line with `small-step`, as [`Block::velocity`] is.
-    #[cfg_attr(feature = "small-step", inline(never))]
-    #[cfg_attr(not(feature = "small-step"), inline(always))]
-    pub(crate) fn set(&mut self, c: usize, x: [i32; 3]) {
-        self.x[c] = x;
-        self.pending |= 1 << c;
+    #[inline(always)]
+    fn dirty(&self) -> u8 {
+        self.dirty
     }
 
-    /// M1: rounds every pending velocity back to storage, one 64-bit output
-    /// of the stream each, in cell order. Out of line with `small-step`:
-    /// one copy for every stage.
-    #[cfg_attr(feature = "small-step", inline(never))]
-    #[cfg_attr(not(feature = "small-step"), inline(always))]
-    pub(crate) fn round<Q: Quant>(&mut self, rng: &mut Stream) {
-        for c in cells_of(self.pending) {
-            self.v[c] = Q::round::<D>(self.x[c], rng);
-        }
-        self.dirty |= self.pending;
-        self.pending = 0;
+    #[inline(always)]
+    fn stored(&self, c: usize) -> [i32; D] {
+        self.v[c]
     }
 
-    /// [`Block::round`] out of line, after the stages that seldom change a
-    /// velocity: a reflection (M5.4) and contacts (M5.7).
-    #[inline(never)]
-    pub(crate) fn round_apart<Q: Quant>(&mut self, rng: &mut Stream) {
-        self.round::<Q>(rng);
+    #[inline(always)]
+    fn put(&mut self, c: usize, q: [i32; D]) {
+        self.v[c] = q;
+        self.dirty |= 1 << c;
+    }
+
+    #[inline(always)]
+    fn component(&self, i: usize) -> i32 {
+        self.v[i / D][i % D]
     }
 }
 

@@ -1,19 +1,14 @@
 //! The plain block of a 2D world of 8-bit velocities (the aggregation's
-//! and the cluster's, most of a 2D gas): the block's stored velocities as
-//! one 64-bit word of byte lanes, lane `2c + k` holding cell `c`'s
-//! component `k`, so that M5.3's first test is a handful of word
-//! operations for the whole block. It makes the draws of
-//! [`Kernel::general`] in the same order, so it gives the same world bit
-//! for bit, and the tests hold it to that.
+//! and the cluster's, most of a 2D gas) as a representation of the
+//! pipeline ([`Stored`]): the block's stored velocities as one 64-bit word
+//! of byte lanes, lane `2c + k` holding cell `c`'s component `k`, so that
+//! M5.3's first test is a handful of word operations for the whole block.
 
-use crate::rules::collision::pick_pair;
 use crate::rules::quant::Quant;
-use crate::rules::rng::Stream;
-use crate::step::block::{cells_of, each_cell};
-use crate::step::clamp::clamp_counted;
-use crate::step::kernel::{per_cell, pushed_small, stored_speed2, Kernel, BLOCKED_KEY_2D, FIELDS, IDENTITY, KEY_2D_WANTS};
+use crate::step::block::Stored;
+use crate::step::assign::per_cell;
 use crate::step::partition::BlockRow;
-use crate::storage::layout::mark;
+use crate::storage::cells::Cells;
 
 /// Per 2D occupancy mask, `0xffff` in the two byte lanes of each occupied
 /// cell.
@@ -57,14 +52,6 @@ fn inward_lanes(lanes: u64, occ: u8) -> u8 {
     ((inward >> 7).wrapping_mul(0x0102_0408_1020_4080) >> 56) as u8
 }
 
-/// Cell `c`'s velocity from a 2D block's byte lanes, in fine units of
-/// `2^-fine` quanta (M1c).
-#[inline(always)]
-fn lane_fine(lanes: u64, c: usize, fine: u32) -> [i32; 3] {
-    let [x, y] = lane_ints(lanes, c);
-    [i32::from(x) << fine, i32::from(y) << fine, 0]
-}
-
 /// Cell `c`'s stored velocity in byte lanes, as integers: bytes `2c` and
 /// `2c + 1` of the word, one indexed load each where `c` is not a
 /// constant (a shift by `16 c` and masks take more instructions and
@@ -94,179 +81,96 @@ fn cell_lanes(lanes: u64, c: usize) -> u32 {
     u32::from((lanes >> (16 * c)) as u16)
 }
 
-impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
-    /// M5.1 (a uniform force) and M5.2 (on `pair`, when both its cells hold
-    /// a particle) on a block of byte lanes ([`Kernel::lean_2d`]), then M1:
-    /// the lanes after rounding, and the cells whose velocity changed. Out
-    /// of line: most blocks of most steps need neither.
-    #[inline(never)]
-    pub(crate) fn change_lanes(&mut self, mut lanes: u64, occ: u8, pair: Option<(usize, usize)>, rng: &mut Stream) -> (u64, u8) {
-        let class = &self.shared.one;
-        // Cell c's lanes replaced by the rounding of x (M1).
-        let round_into = |lanes: u64, c: usize, x: [i32; 3], rng: &mut Stream| {
-            with_lane_ints(lanes, c, Q::round::<2>(x, rng).map(|q| Q::from_int(q).to_int()))
-        };
-        if self.shared.lean_push.is_none() {
-            // The collision alone: its two results rounded in cell order
-            // (a < c in every pair), as the loop below would.
-            let Some((a, c)) = pair else { return (lanes, 0) };
-            debug_assert!(a < c);
-            let Some((xa, xc)) = self.collide_two(lane_fine(lanes, a, Q::FINE), lane_fine(lanes, c, Q::FINE), (*class, *class), true, rng) else {
-                return (lanes, 0);
-            };
-            // The four components together: 32 bits for a, then 32 for c.
-            let r = [rng.bits(32), rng.bits(32)];
-            let x = [xa[0], xa[1], xc[0], xc[1]];
-            let q: [i32; 4] = core::array::from_fn(|i| Q::stochastic(x[i], r[i / 2] >> (16 * (i & 1))));
-            // 8-bit rounding stays within the stored range (+-127).
-            lanes = with_lane_ints(with_lane_ints(lanes, a, [q[0], q[1]]), c, [q[2], q[3]]);
-            return (lanes, 1 << a | 1 << c);
-        }
-        let mut x = [[0i32; 3]; CELLS];
-        let mut pending = 0u8;
-        if let Some(dv) = self.shared.lean_push {
-            for c in cells_of(occ) {
-                let mut y = pushed_small(lane_fine(lanes, c, Q::FINE), dv);
-                clamp_counted::<D>(&mut y, Q::UNIT, class, &mut self.counters);
-                x[c] = y;
-            }
-            pending = occ;
-        }
-        if let Some((a, c)) = pair {
-            let get = |c: usize| if pending >> c & 1 != 0 { x[c] } else { lane_fine(lanes, c, Q::FINE) };
-            if let Some(pair) = self.collide_two(get(a), get(c), (*class, *class), true, rng) {
-                (x[a], x[c]) = pair;
-                pending |= 1 << a | 1 << c;
-            }
-        }
-        for c in cells_of(pending) {
-            lanes = round_into(lanes, c, x[c], rng);
-        }
-        (lanes, pending)
+/// A plain 2D block of an 8-bit world as the pipeline holds it: its
+/// stored velocities as one word of byte lanes, lane `2c + k` holding cell
+/// `c`'s component `k`, read and written a block row (two cells, one
+/// 32-bit word) at a time.
+pub(crate) struct Lanes {
+    lanes: u64,
+    /// The occupied cells in the low byte, those whose velocity changed
+    /// (`dirty`) in the high: two fields in all, so that the block goes
+    /// to and from a call in two registers.
+    cells: u16,
+}
+
+// Generic in `D` for the pipeline's sake; only 2D blocks are lanes.
+impl<const D: usize> Stored<D> for Lanes {
+    #[inline(always)]
+    fn occ(&self) -> u8 {
+        self.cells as u8
     }
 
-    /// [`Kernel::lean`] for a 2D block of an 8-bit world whose two cells of
-    /// each row are neighbours (no wrap: `x0 + 1 < nx`), in a world without
-    /// contacts. The block's stored velocities are read as one 64-bit word
-    /// of byte lanes, lane `2c + k` holding cell `c`'s component `k` (two
-    /// 32-bit reads, one a block row): which particles want to cross an
-    /// axis inward is a handful of word operations for the whole block, and
-    /// only those axes read the move table. A velocity a stage changes is
-    /// rounded back into its lanes. The draws are those of
-    /// [`Kernel::general`], in the same order, so the world is the same bit
-    /// for bit.
     #[inline(always)]
-    pub(crate) fn lean_2d(&mut self, row: &BlockRow, x0: usize, index: u64, occ: u8) {
-        let sh = self.shared;
-        let velocity = self.planes.velocity;
-        // Both block rows, occupied or not: the lanes of an empty cell are
-        // never read as a velocity (every use is masked by `occ`), and a
-        // row written back whole writes them back as they were.
+    fn dirty(&self) -> u8 {
+        (self.cells >> 8) as u8
+    }
+
+    #[inline(always)]
+    fn stored(&self, c: usize) -> [i32; D] {
+        let (ints, mut q) = (lane_ints(self.lanes, c), [0; D]);
+        for k in 0..D {
+            q[k] = i32::from(ints[k]);
+        }
+        q
+    }
+
+    #[inline(always)]
+    fn put(&mut self, c: usize, q: [i32; D]) {
+        self.lanes = with_lane_ints(self.lanes, c, [q[0], q[1]]);
+        self.cells |= 1 << (8 + c);
+    }
+
+    /// Lane `i`'s byte, one indexed load where `i` is not a constant (a
+    /// shift of the word by `8 i` takes three instructions).
+    #[inline(always)]
+    fn component(&self, i: usize) -> i32 {
+        i32::from(self.lanes.to_le_bytes()[i] as i8)
+    }
+
+    #[inline(always)]
+    fn inward(&self) -> u8 {
+        inward_lanes(self.lanes, self.cells as u8)
+    }
+}
+
+impl Lanes {
+    /// The block whose block rows start at cells `x0 + row.cell[r]` of the
+    /// velocity plane, both rows read whole, occupied or not: the lanes of
+    /// an empty cell are never read as a velocity (every use is masked by
+    /// `occ`), and a row written back whole writes them back as they were.
+    ///
+    /// # Safety
+    /// `x0 + 1 + row.cell[r]` lies in the plane for both rows (the row
+    /// plan's bound, `RowPlan::lean_below`).
+    #[inline(always)]
+    pub(crate) unsafe fn load<Q: Quant, const D: usize>(velocity: Cells<'_, [Q; D]>, row: &BlockRow, x0: usize, occ: u8) -> Lanes {
         let mut lanes = 0u64;
         for r in 0..2 {
-            // SAFETY: x0 < RowPlan::lean_below, so x0 + 1 + row.cell[r] is
-            // below the plane's length (`plan`).
+            // SAFETY: the caller's bound.
             let pair = unsafe { velocity.pair_unchecked(x0 + row.cell[r]) };
             lanes |= u64::from(Q::lanes_2d(pair)) << (32 * r);
         }
-        let mut rng = sh.key.stream(index);
-        let pair = pick_pair::<D>(occ, &mut rng);
-        let mut pending = 0u8;
-        if sh.lean_push.is_some() || pair.is_some() {
-            (lanes, pending) = self.change_lanes(lanes, occ, pair, &mut rng);
-        }
-
-        // M5.3: the lanes that point inward, then a move table entry for
-        // each of those only ([`Kernel::decide`]'s draws).
-        let mut want = 0u8;
-        let inward = inward_lanes(lanes, occ);
-        if inward != 0 {
-            // Lane i's random byte and stored component as byte i of an
-            // array: one indexed load each, where a shift of the word by
-            // 8i took three instructions.
-            let bytes = rng.next_u64().to_le_bytes();
-            let stored = lanes.to_le_bytes();
-            let (table, tops) = (sh.moves, sh.tops());
-            let mut todo = u32::from(inward);
-            while todo != 0 {
-                let i = todo.trailing_zeros() as usize;
-                todo &= todo - 1;
-                let v = usize::from(stored[i]);
-                let (high, top) = (bytes[i], tops[v]);
-                if high < top || high == top && rng.bits(8) <= u32::from(table[v]) & 0xff {
-                    want |= 1 << i;
-                }
-            }
-        }
-
-        self.counters.processed += 1;
-        if want != 0 {
-            self.finish_2d(row, x0, occ, lanes, want, pending, &mut rng);
-        } else if pending != 0 {
-            self.write_rows(row, x0, lanes, pending);
-        }
+        Lanes { lanes, cells: u16::from(occ) }
     }
 
-    /// The block rows of a lanes block holding a velocity that changed
-    /// (`pending`), written back whole from `lanes` (the row's other cell
-    /// as it was read), where no particle moved.
+    /// Cell `c`'s stored velocity as the plane holds it.
     #[inline(always)]
-    pub(crate) fn write_rows(&mut self, row: &BlockRow, x0: usize, lanes: u64, pending: u8) {
-        for r in 0..2 {
-            if pending >> (2 * r) & 3 != 0 {
-                // SAFETY: as for the read in `lean_2d`: x0 < lean_below.
-                unsafe { self.planes.velocity.set_pair_unchecked(x0 + row.cell[r], Q::pair_from_lanes((lanes >> (32 * r)) as u32)) };
-            }
-        }
+    pub(crate) fn to_plane<Q: Quant, const D: usize>(&self, c: usize) -> [Q; D] {
+        // Cell c's two lanes, as the first cell of a pair.
+        Q::pair_from_lanes(cell_lanes(self.lanes, c))[0]
     }
 
-    /// The rest of [`Kernel::lean_2d`] for a block where a particle wants
-    /// to move: M5.6, then the moved velocities and those that changed
-    /// (`pending`) and the occupancy written back. Out of line: in a
-    /// cooling gas most blocks need none of it, and the sweep's loop keeps
-    /// its registers.
+    /// The block rows holding a velocity that changed, written back whole
+    /// (the row's other cell as it was read), where no particle moved.
+    ///
+    /// # Safety
+    /// As for [`Lanes::load`], with the same `velocity`, `row` and `x0`.
     #[inline(never)]
-    #[allow(clippy::too_many_arguments)]
-    pub(crate) fn finish_2d(&mut self, row: &BlockRow, x0: usize, occ: u8, lanes: u64, want: u8, pending: u8, rng: &mut Stream) {
-        let sh = self.shared;
-        let velocity = self.planes.velocity;
-        // M5.6.
-        let wants = [want & 3, want >> 2 & 3, want >> 4 & 3, want >> 6];
-        let mut per_cell = [0u8; CELLS];
-        per_cell[..4].copy_from_slice(&wants);
-        let key = 2 * usize::from(BLOCKED_KEY_2D[usize::from(occ)]) + usize::from(KEY_2D_WANTS[usize::from(want)]);
-        let targets = self.assign(occ, |c| { let [x, y] = lane_ints(lanes, c); stored_speed2([i32::from(x), i32::from(y)]) }, 0, &per_cell, key, rng);
-        if (targets ^ IDENTITY) & FIELDS[usize::from(occ)] == 0 {
-            return self.write_rows(row, x0, lanes, pending);
-        }
-        let mut after = 0u8;
-        each_cell!(CELLS, c => {
-            if occ >> c & 1 != 0 {
-                let t = (targets >> (4 * c) & 7) as usize;
-                after |= 1 << t;
-                if t != c || pending >> c & 1 != 0 {
-                    // Cell c's two lanes, as the first cell of a pair.
-                    let [stored, _] = Q::pair_from_lanes(cell_lanes(lanes, c));
-                    velocity.set(x0 + (t & 1) + row.cell[t >> 1], stored);
-                }
-            }
-        });
-        if x0 & 63 == 63 {
-            // The block's cells lie in two occupancy words (rare).
-            return self.occupy(row, [x0, x0 + 1], occ, after);
-        }
-        let shift = x0 & 63;
+    pub(crate) unsafe fn write_rows<Q: Quant, const D: usize>(&self, velocity: Cells<'_, [Q; D]>, row: &BlockRow, x0: usize) {
         for r in 0..2 {
-            let (old, new) = (u64::from(occ >> (2 * r) & 3), u64::from(after >> (2 * r) & 3));
-            if old != new {
-                let at = row.word[r] + (x0 >> 6);
-                let w = self.planes.occupancy.get(at);
-                self.planes.occupancy.set(at, w & !(3 << shift) | new << shift);
-                // A row that held no particle of the block may have been
-                // swept as empty: flag it again (M3).
-                if old == 0 {
-                    mark(self.planes.rows, self.planes.words, sh.part.summary_words, row.line[r], x0);
-                }
+            if self.cells >> (8 + 2 * r) & 3 != 0 {
+                // SAFETY: the caller's bound.
+                unsafe { velocity.set_pair_unchecked(x0 + row.cell[r], Q::pair_from_lanes((self.lanes >> (32 * r)) as u32)) };
             }
         }
     }
@@ -279,12 +183,12 @@ mod tests {
     use crate::{Description, World};
 
     #[test]
-    fn the_lanes_routine_gives_the_general_ones_world_at_the_row_ends() {
+    fn lanes_give_every_parts_world_at_the_row_ends() {
         // Expect: a crowded periodic 8 x 6 world of 8-bit velocities
-        // (every block of a row but the wrapping one goes through the
-        // lanes routine, whose reads and writes are unchecked under the
-        // row plan's bound: under Miri they are checked here) steps to the
-        // same world, bit for bit, as through the general routine alone,
+        // (every block of a row but the wrapping one is held as lanes,
+        // whose reads and writes are unchecked under the row plan's
+        // bound: under Miri they are checked here) steps to the same
+        // world, bit for bit, as through the pipeline with every part,
         // at both offsets; its particles collide, move and stay put.
         let desc = Description::new_2d(8, 6);
         let mut rng = block_stream(8, 6, 0);

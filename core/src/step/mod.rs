@@ -2,21 +2,27 @@
 //! every occupied block of the step's Margolus partition (M3), then the
 //! counters and the step number.
 //!
-//! The description fixes, once per step, which specialised block routine
-//! runs (M9): the stored velocity width and the dimension are compile-time
-//! parameters of [`Kernel`]; the force path and the optional parts are
-//! switches read once per block at most, and a world without them sends its
-//! blocks through the lean routines, which have no code for them.
+//! The description fixes, once per step, how the block pipeline
+//! ([`Kernel`]) is instantiated (M9): the stored velocity width and the
+//! dimension are compile-time parameters; the force path and the optional
+//! parts are switches read once per block at most, and a world without
+//! them sends its blocks through the plain instantiations, which have no
+//! code for them.
 
 
+pub(crate) mod assign;
 pub(crate) mod block;
 pub(crate) mod clamp;
+pub(crate) mod collision;
 pub(crate) mod contacts;
 pub(crate) mod emit;
+pub(crate) mod force;
 pub(crate) mod kernel;
 pub(crate) mod lanes;
+pub(crate) mod moves;
 pub(crate) mod partition;
 pub(crate) mod reflection;
+pub(crate) mod rounding;
 #[cfg(target_has_atomic = "8")]
 pub(crate) mod tasks;
 
@@ -52,7 +58,7 @@ type Split<'h> = Option<(usize, Host<'h>)>;
 type Split<'h> = Option<(usize, core::marker::PhantomData<&'h ()>)>;
 
 /// How a step visits its blocks: in which order, and whether blocks of a
-/// plain world may take the lean routine.
+/// plain world may take a plain instantiation of the pipeline.
 #[derive(Clone, Copy)]
 pub(crate) struct Route {
     reverse: bool,
@@ -79,8 +85,8 @@ impl World {
         self.step_routed(Route { reverse: order == Order::Reverse, lean: true, skip: true });
     }
 
-    /// Advances one step with every block through the block routine that
-    /// handles every part (none through the lean one that plain worlds use
+    /// Advances one step with every block through the pipeline with every
+    /// part (none through the plain instantiations that plain worlds use
     /// away from the faces), and with every row and word of the occupancy
     /// swept (none skipped on the summaries' word). The world is the same
     /// bit for bit: the tests compare the two (feature `reference`, and
@@ -238,8 +244,8 @@ impl World {
         // Component by component: an array comparison is a `memcmp` call on
         // small cores.
         let pushes = push[0] | push[1] | push[2] != 0;
-        // With `small-step` every block takes the general routine: nothing
-        // is plain, and nothing the lean routines read is set up.
+        // With `small-step` every block takes the pipeline with every part:
+        // nothing is plain, and nothing only the plain ones read is set up.
         let lean = !cfg!(feature = "small-step") && route.lean;
         let plain = lean && !desc.has_masses() && !desc.lifetimes && !summed && small_push;
         let shared = Shared {

@@ -8,8 +8,12 @@ use crate::rules::collision::WIDEST;
 use crate::rules::faces::{resolve, Beyond, Coords};
 use crate::rules::fixed::scaled;
 use crate::rules::obstacle::{axis_q30, dot_q30, normal_q30, reflect, surface_at, Surface};
-use crate::step::block::{Class, Shared};
+use crate::rules::quant::Quant;
+use crate::rules::rng::Stream;
+use crate::step::block::{Class, Shared, Stored};
 use crate::step::clamp::clamp_counted;
+use crate::step::kernel::{Carried, Kernel, Site};
+use crate::step::rounding::round_one;
 use crate::storage::layout::{row_words, test_bit};
 use crate::storage::world::Counters;
 
@@ -23,15 +27,30 @@ pub(crate) fn back_normal<const D: usize>(from: usize, to: usize) -> [i32; 3] {
     axis_q30(n)
 }
 
-/// A blocked cell a particle wants (M5.4): its number in the block, its
-/// dense index in the planes (meaningless beyond a face), its coordinates
-/// (possibly beyond a face) and whether it lies beyond a wall.
+impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
+    /// M5.4 for the particle in cell `c` of `b`, which wants to cross the
+    /// axes `m`: whether the cell it wants is blocked, in which case its
+    /// velocity is reflected ([`reflect_off`]) and rounded at once (M1),
+    /// and it stays.
+    #[inline(always)]
+    pub(crate) fn reflects(&mut self, site: &Site<'_>, b: &mut impl Stored<D>, c: usize, m: u8, carried: &Carried<CELLS>, rng: &mut Stream) -> bool {
+        let t = c ^ usize::from(m);
+        if m == 0 || site.blocked >> t & 1 == 0 {
+            return false;
+        }
+        if let Some(x) = reflect_off(self.shared, b.fine(c, Q::FINE), c, Wanted { site, cell: t }, &carried.class(self.shared, c), Q::UNIT, &mut self.counters, D) {
+            round_one::<Q, D, CELLS>(b, c, x, rng);
+        }
+        true
+    }
+}
+
+/// A blocked cell a particle wants (M5.4): its number `cell` in the block
+/// at `site`.
 #[derive(Clone, Copy)]
-pub(crate) struct Wanted {
+pub(crate) struct Wanted<'s, 'r> {
+    pub(crate) site: &'s Site<'r>,
     pub(crate) cell: usize,
-    pub(crate) site: usize,
-    pub(crate) at: Coords,
-    pub(crate) wall: bool,
 }
 
 /// M5.4: the particle in cell `c` of class `class`, with velocity `x` (in
@@ -52,16 +71,19 @@ pub(crate) fn reflect_off(sh: &Shared<'_>, mut x: [i32; 3], c: usize, to: Wanted
         x[2] = 0;
     }
     let t = to.cell;
+    // Its place in the planes (meaningless beyond a face) and its
+    // coordinates (possibly beyond a face).
+    let (site, at) = (to.site.cell(t), to.site.at(t));
     let mut surface = None;
-    if to.wall {
-        if let Beyond::Wall(n) = resolve(sh.n, &sh.desc.boundary, to.at) {
+    if to.site.wall >> t & 1 != 0 {
+        if let Beyond::Wall(n) = resolve(sh.n, &sh.desc.boundary, at) {
             surface = Some((axis_q30(n), sh.desc.wall_restitution));
         }
     }
     // A build without obstacles has no surface entry and no obstacle
     // cell (here and below), and no code to look either up.
     let table: &[Surface] = if cfg!(feature = "obstacles") { sh.surface } else { &[] };
-    let (n, e) = surface.unwrap_or_else(|| match surface_at(table, to.site as u32) {
+    let (n, e) = surface.unwrap_or_else(|| match surface_at(table, site as u32) {
         // Component by component: a copy of the array through the
         // reference is a `memmove` call at opt-level z, the only one in a
         // firmware build.
@@ -93,7 +115,7 @@ pub(crate) fn reflect_off(sh: &Shared<'_>, mut x: [i32; 3], c: usize, to: Wanted
         // face the particle (a half-space seen across a periodic seam, a
         // mask corner), it would press on the obstacle for ever: reflect
         // off the face it came through. M5.4.
-        let mut at = to.at;
+        let mut at = at;
         for (k, a) in at.iter_mut().enumerate().take(dim) {
             *a += ((c >> k) & 1) as isize - ((t >> k) & 1) as isize;
         }
