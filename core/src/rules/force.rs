@@ -7,7 +7,7 @@
 
 use crate::api::desc::Vortex;
 use crate::rules::fixed::{magnitude, quot, sat, scaled, scaled_by, to_fine, udiv, SCALED_MAX};
-use crate::step::block::Class;
+use crate::rules::class::Class;
 
 /// The force terms of one step, read-only, for the general force path.
 pub(crate) struct ForceTerms<'a> {

@@ -2,6 +2,7 @@
 //! particles of a block, independent of where a world keeps them.
 
 pub mod assign;
+pub(crate) mod class;
 pub(crate) mod collision;
 pub(crate) mod emitter;
 pub(crate) mod faces;

@@ -36,7 +36,7 @@ pub(crate) fn unit_of(quantization: crate::api::desc::Quantization) -> i32 {
 }
 
 /// A stored velocity component type.
-pub(crate) trait Quant: Copy + Default + Send + crate::storage::layout::Plain + 'static {
+pub(crate) trait Quant: Copy + Default + Send + crate::storage::plain::Plain + 'static {
     /// Stored steps per unit speed.
     const SCALE: f32;
     fn from_int(q: i32) -> Self;

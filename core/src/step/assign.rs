@@ -6,7 +6,7 @@ use crate::rules::assign::{assign_moves, optimal_moves_2d, pick_move, Method, Mo
 use crate::rules::quant::Quant;
 use crate::rules::rng::Stream;
 use crate::step::block::cells_of;
-use crate::step::kernel::Kernel;
+use crate::step::block::Kernel;
 
 /// The squared length of a stored velocity, exact: what greedy ranks by
 /// (M5.6). It fits: `3 * 32767^2` is below `2^32`.

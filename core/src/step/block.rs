@@ -1,15 +1,19 @@
-//! What a block routine works with: the data every block of a step reads,
-//! the planes the step writes, and one block's particles as the stages of
-//! M5 see them.
+//! What the block pipeline works with: the data every block of a step
+//! reads, the planes the step writes, the pipeline's parameters (the parts
+//! it has code for), where a block lies and what its particles carry, and
+//! one block's particles as the stages of M5 see them.
 
 use crate::api::desc::Description;
 use crate::rules::assign::{bits, Bits};
+use crate::rules::class::Class;
+use crate::rules::faces::Coords;
 use crate::rules::force::{Flow, ForceTerms};
 use crate::rules::obstacle::Surface;
 use crate::rules::quant::Quant;
 use crate::rules::rng::StepKey;
 use crate::step::partition::{BlockRow, Partition};
 use crate::storage::cells::Cells;
+use crate::storage::world::Counters;
 
 /// The description as a step's blocks read it: with `small-step` where it
 /// lies in the world's header (no copy to set up: less flash, a load more
@@ -20,29 +24,6 @@ pub(crate) type StepDescription<'a> = &'a Description;
 #[cfg(not(feature = "small-step"))]
 pub(crate) type StepDescription<'a> = Description;
 
-/// A mass class as a step's blocks read it, converted from its mass once a
-/// step (M1c). Laid out without padding: the classes of a world of masses
-/// lie in its memory ([`mass_plane`](crate::storage::layout::mass_plane)).
-#[derive(Clone, Copy, Default)]
-#[repr(C)]
-pub(crate) struct Class {
-    /// M1c's `K = quot(dt, m)`: the velocity, in unit speeds, a unit of
-    /// force adds in a step. A force's push is its exact product with this
-    /// and `W`, rounded.
-    pub push: f32,
-    /// M1c's `M`: the mass relative to the largest in use, `2^24` for that
-    /// one (at least 1), from which a collision takes the shares.
-    pub relative: u32,
-    /// Units of the clamp's energy counter a fine unit squared of speed
-    /// removed is worth: `m 2^31 / W^2` (M5.5, M10), by [`quot`](crate::rules::fixed::quot).
-    pub energy: f32,
-    /// Unused: brings `swirl` to its alignment.
-    pub spare: u32,
-    /// The vortex's strength as a push for this class (M1c's `Γ'`), 0
-    /// without a vortex.
-    pub swirl: i64,
-}
-
 impl Shared<'_> {
     /// The class of mass index `i`: the first where the index names none
     /// (no index an API call writes does; an image's are checked).
@@ -51,6 +32,138 @@ impl Shared<'_> {
         match self.classes.get(usize::from(i)) {
             Some(c) => *c,
             None => self.one,
+        }
+    }
+}
+
+/// The block pipeline (`step/kernel.rs`), specialised once per step (M9) on the stored
+/// velocity type `Q` and the dimension `D` (with `CELLS = 2^D` cells a
+/// block). Summed forces, obstacles, per-particle masses and lifetimes are
+/// per-step switches: each costs a predictable branch per block or per
+/// particle where the pipeline has code for [`Every`] part, and sends every
+/// block there when it is on ([`Shared::plain`]), so the plain
+/// instantiations never test them.
+pub(crate) struct Kernel<'a, Q, const D: usize, const CELLS: usize> {
+    pub shared: &'a Shared<'a>,
+    pub planes: Writable<'a, Q, D>,
+    pub counters: Counters,
+}
+
+/// The parts of a step an instantiation of the pipeline has code for (M9).
+pub(crate) trait Parts {
+    /// Every part, each read from the step's description: the faces,
+    /// obstacles, masses, lifetimes, summed forces and drag. Without it
+    /// the block is a plain world's ([`Shared::plain`]), away from the
+    /// faces and the block that wraps round x, and holds no obstacle
+    /// ([`RowPlan`](crate::step::kernel::RowPlan)); its cells are unrolled.
+    const ALL: bool;
+    /// M5.7 may be on (read from the description).
+    const CONTACTS: bool;
+}
+
+/// Every part: the blocks on the faces, with obstacles, and every block
+/// of a world that is not plain.
+pub(crate) struct Every;
+/// A plain world's block away from the faces and obstacles.
+pub(crate) struct Plain;
+/// [`Plain`] in a world without contacts ([`Shared::lanes`]).
+pub(crate) struct Bare;
+
+impl Parts for Every {
+    const ALL: bool = true;
+    const CONTACTS: bool = true;
+}
+impl Parts for Plain {
+    const ALL: bool = false;
+    const CONTACTS: bool = true;
+}
+impl Parts for Bare {
+    const ALL: bool = false;
+    const CONTACTS: bool = false;
+}
+
+/// Where a block lies (M3, M4): its cells in the planes, and the cells
+/// beyond a face or blocked.
+pub(crate) struct Site<'r> {
+    pub row: &'r BlockRow,
+    /// The x of the block's lowest corner (-1 for the half block on a low
+    /// face).
+    pub x0: isize,
+    /// Cell `c` lies at x `xs[c & 1]` of block row `c >> 1` (y, then z).
+    pub xs: [usize; 2],
+    /// Cells beyond a wall face, and beyond an open one (their sites mean
+    /// nothing).
+    pub wall: u8,
+    pub open: u8,
+    /// Cells no particle may enter: beyond a wall, or an obstacle's.
+    pub blocked: u8,
+}
+
+impl<'r> Site<'r> {
+    /// A plain block's site: block `x0` of `row`, whose cells are all
+    /// inside the domain and none blocked.
+    #[inline(always)]
+    pub(crate) fn plain(row: &'r BlockRow, x0: usize) -> Self {
+        Site { row, x0: x0 as isize, xs: [x0, x0 + 1], wall: 0, open: 0, blocked: 0 }
+    }
+
+    /// The dense index of cell `c` in the planes.
+    #[inline(always)]
+    pub(crate) fn cell(&self, c: usize) -> usize {
+        // A choice, not an index: the two x stay in registers.
+        (if c & 1 == 0 { self.xs[0] } else { self.xs[1] }) + self.row.cell[c >> 1]
+    }
+
+    /// The raw coordinates of cell `c` (beyond a face where it lies there).
+    #[inline(always)]
+    pub(crate) fn at(&self, c: usize) -> Coords {
+        [self.x0 + (c & 1) as isize, self.row.origin[0] + ((c >> 1) & 1) as isize, self.row.origin[1] + ((c >> 2) & 1) as isize]
+    }
+}
+
+/// What the particles of a block carry besides their velocity (M9): their
+/// mass indices and lifetimes, read where the world has them.
+pub(crate) struct Carried<const CELLS: usize> {
+    /// Read through [`Carried::masses`].
+    masses: bool,
+    pub lifetimes: bool,
+    pub mass_index: [u8; CELLS],
+    /// 0 (none) in worlds without lifetimes.
+    pub life: [u16; CELLS],
+}
+
+impl<const CELLS: usize> Carried<CELLS> {
+    /// The particles carry mass indices: never in a build without the
+    /// feature `mass`, where this folds to false (the switch alone, kept
+    /// in the struct, does not always).
+    #[inline(always)]
+    pub(crate) fn masses(&self) -> bool {
+        cfg!(feature = "mass") && self.masses
+    }
+
+    /// Nothing: a plain world's particles carry no mass index and no
+    /// lifetime.
+    #[inline(always)]
+    pub(crate) fn none() -> Self {
+        Carried::new(false, false)
+    }
+
+    /// Particles that carry mass indices where `masses`, lifetimes where
+    /// `lifetimes`, all 0 until read.
+    #[inline(always)]
+    pub(crate) fn new(masses: bool, lifetimes: bool) -> Self {
+        Carried { masses, lifetimes, mass_index: [0; CELLS], life: [0; CELLS] }
+    }
+
+    /// The mass class of the particle in cell `c`: the world's one where
+    /// particles carry none (no array read, so no bounds check, in a build
+    /// without masses).
+    #[inline(always)]
+    pub(crate) fn class(&self, sh: &Shared<'_>, c: usize) -> Class {
+        if self.masses() {
+            sh.class(self.mass_index[c])
+        } else {
+            sh.one
         }
     }
 }

@@ -3,7 +3,7 @@
 //! removed are counted, since they are error of the model (M10).
 
 use crate::rules::fixed::{count_times, shorten, sq};
-use crate::step::block::Class;
+use crate::rules::class::Class;
 use crate::storage::world::Counters;
 
 /// M5.5: clamps `x` (in fine units) to the speed limit `unit` (fine units

@@ -7,9 +7,9 @@ use crate::rules::collision::{collide_limited, collide_pair, difference, energy_
 use crate::rules::fixed::{csqrt, sq};
 use crate::rules::quant::Quant;
 use crate::rules::rng::Stream;
-use crate::step::block::Class;
+use crate::rules::class::Class;
 use crate::step::clamp::clamp_counted;
-use crate::step::kernel::Kernel;
+use crate::step::block::Kernel;
 
 /// M5.2b's limit on a squared speed in fine units (M1c): a unit speed
 /// `unit` less `sqrt(D)` quanta (`2^fine` fine units each) rounded up,

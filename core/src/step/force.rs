@@ -3,9 +3,10 @@
 
 use crate::rules::fixed::{fit, mulq, sat};
 use crate::rules::quant::Quant;
-use crate::step::block::{cells_of, Class, Stored};
+use crate::rules::class::Class;
+use crate::step::block::{cells_of, Stored};
 use crate::step::clamp::clamp_counted;
-use crate::step::kernel::{Carried, Kernel, Parts, Site};
+use crate::step::block::{Carried, Kernel, Parts, Site};
 use crate::step::rounding::Changes;
 
 /// M5.1's sum `x + dv` of a velocity within a unit speed and a push (fine

@@ -54,65 +54,17 @@
 //! M5.1 draws nothing.
 
 use crate::rules::collision::pick_pair;
-use crate::rules::faces::{resolve, Beyond, Coords};
+use crate::rules::faces::{resolve, Beyond};
 use crate::rules::quant::Quant;
 use crate::rules::rng::Stream;
-use crate::step::assign::{FIELDS, IDENTITY};
-use crate::step::assign::stored_speed2;
-use crate::step::block::{cells_of, each_occupied, Block, Class, Shared, Stored, Writable};
+use crate::step::assign::{stored_speed2, FIELDS, IDENTITY};
+use crate::step::block::{cells_of, each_occupied, Bare, Block, Carried, Every, Kernel, Parts, Plain, Site, Stored};
 use crate::step::contacts::contacts;
 use crate::step::lanes::Lanes;
 use crate::step::partition::{cells_at, BlockRow, BlockSink, Index};
 use crate::step::rounding::{round_apart, Changes};
 use crate::storage::cells::Cells;
 use crate::storage::layout::{mark, put_bit};
-use crate::storage::world::Counters;
-
-/// The block pipeline, specialised once per step (M9) on the stored
-/// velocity type `Q` and the dimension `D` (with `CELLS = 2^D` cells a
-/// block). Summed forces, obstacles, per-particle masses and lifetimes are
-/// per-step switches: each costs a predictable branch per block or per
-/// particle where the pipeline has code for [`Every`] part, and sends every
-/// block there when it is on ([`Shared::plain`]), so the plain
-/// instantiations never test them.
-pub(crate) struct Kernel<'a, Q, const D: usize, const CELLS: usize> {
-    pub shared: &'a Shared<'a>,
-    pub planes: Writable<'a, Q, D>,
-    pub counters: Counters,
-}
-
-/// The parts of a step an instantiation of the pipeline has code for (M9).
-pub(crate) trait Parts {
-    /// Every part, each read from the step's description: the faces,
-    /// obstacles, masses, lifetimes, summed forces and drag. Without it
-    /// the block is a plain world's ([`Shared::plain`]), away from the
-    /// faces and the block that wraps round x, and holds no obstacle
-    /// ([`RowPlan`]); its cells are unrolled.
-    const ALL: bool;
-    /// M5.7 may be on (read from the description).
-    const CONTACTS: bool;
-}
-
-/// Every part: the blocks on the faces, with obstacles, and every block
-/// of a world that is not plain.
-pub(crate) struct Every;
-/// A plain world's block away from the faces and obstacles.
-pub(crate) struct Plain;
-/// [`Plain`] in a world without contacts ([`Shared::lanes`]).
-pub(crate) struct Bare;
-
-impl Parts for Every {
-    const ALL: bool = true;
-    const CONTACTS: bool = true;
-}
-impl Parts for Plain {
-    const ALL: bool = false;
-    const CONTACTS: bool = true;
-}
-impl Parts for Bare {
-    const ALL: bool = false;
-    const CONTACTS: bool = false;
-}
 
 /// A representation of a block's velocities ([`Stored`]) with its reads
 /// and writes of the velocity plane.
@@ -162,85 +114,6 @@ impl<Q: Quant, const D: usize> Plane<Q, D> for Lanes {
         // SAFETY: a lanes block is loaded only where the row plan's bound
         // holds for its x0 (`visit`).
         unsafe { self.write_rows(velocity, site.row, site.xs[0]) }
-    }
-}
-
-/// Where a block lies (M3, M4): its cells in the planes, and the cells
-/// beyond a face or blocked.
-pub(crate) struct Site<'r> {
-    pub row: &'r BlockRow,
-    /// The x of the block's lowest corner (-1 for the half block on a low
-    /// face).
-    pub x0: isize,
-    /// Cell `c` lies at x `xs[c & 1]` of block row `c >> 1` (y, then z).
-    pub xs: [usize; 2],
-    /// Cells beyond a wall face, and beyond an open one (their sites mean
-    /// nothing).
-    pub wall: u8,
-    pub open: u8,
-    /// Cells no particle may enter: beyond a wall, or an obstacle's.
-    pub blocked: u8,
-}
-
-impl<'r> Site<'r> {
-    /// A plain block's site: block `x0` of `row`, whose cells are all
-    /// inside the domain and none blocked.
-    #[inline(always)]
-    pub(crate) fn plain(row: &'r BlockRow, x0: usize) -> Self {
-        Site { row, x0: x0 as isize, xs: [x0, x0 + 1], wall: 0, open: 0, blocked: 0 }
-    }
-
-    /// The dense index of cell `c` in the planes.
-    #[inline(always)]
-    pub(crate) fn cell(&self, c: usize) -> usize {
-        // A choice, not an index: the two x stay in registers.
-        (if c & 1 == 0 { self.xs[0] } else { self.xs[1] }) + self.row.cell[c >> 1]
-    }
-
-    /// The raw coordinates of cell `c` (beyond a face where it lies there).
-    #[inline(always)]
-    pub(crate) fn at(&self, c: usize) -> Coords {
-        [self.x0 + (c & 1) as isize, self.row.origin[0] + ((c >> 1) & 1) as isize, self.row.origin[1] + ((c >> 2) & 1) as isize]
-    }
-}
-
-/// What the particles of a block carry besides their velocity (M9): their
-/// mass indices and lifetimes, read where the world has them.
-pub(crate) struct Carried<const CELLS: usize> {
-    /// Read through [`Carried::masses`].
-    masses: bool,
-    pub lifetimes: bool,
-    pub mass_index: [u8; CELLS],
-    /// 0 (none) in worlds without lifetimes.
-    pub life: [u16; CELLS],
-}
-
-impl<const CELLS: usize> Carried<CELLS> {
-    /// The particles carry mass indices: never in a build without the
-    /// feature `mass`, where this folds to false (the switch alone, kept
-    /// in the struct, does not always).
-    #[inline(always)]
-    pub(crate) fn masses(&self) -> bool {
-        cfg!(feature = "mass") && self.masses
-    }
-
-    /// Nothing: a plain world's particles carry no mass index and no
-    /// lifetime.
-    #[inline(always)]
-    pub(crate) fn none() -> Self {
-        Carried { masses: false, lifetimes: false, mass_index: [0; CELLS], life: [0; CELLS] }
-    }
-
-    /// The mass class of the particle in cell `c`: the world's one where
-    /// particles carry none (no array read, so no bounds check, in a build
-    /// without masses).
-    #[inline(always)]
-    pub(crate) fn class(&self, sh: &Shared<'_>, c: usize) -> Class {
-        if self.masses() {
-            sh.class(self.mass_index[c])
-        } else {
-            sh.one
-        }
     }
 }
 
@@ -335,7 +208,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
             return Carried::none();
         }
         let desc = &self.shared.desc;
-        let mut carried = Carried { masses: desc.has_masses(), lifetimes: desc.lifetimes, mass_index: [0; CELLS], life: [0; CELLS] };
+        let mut carried = Carried::new(desc.has_masses(), desc.lifetimes);
         for c in cells_of(occ) {
             if carried.masses() {
                 carried.mass_index[c] = self.planes.mass_index.get(site.cell(c));
@@ -579,6 +452,7 @@ impl<'a, Q: Quant, const D: usize, const CELLS: usize> BlockSink<'a> for Kernel<
 mod tests {
     use super::*;
     use crate::api::desc::Boundary;
+    use crate::rules::faces::Coords;
 
     #[test]
     fn a_wall_is_only_asked_for_against_its_normal() {

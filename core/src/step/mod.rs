@@ -30,8 +30,9 @@ use crate::rules::fixed::{divr, magnitude, quot, scaled, scaled_by, to_fine, uni
 use crate::rules::force::{Flow, ForceTerms, Swirl};
 use crate::rules::quant::Quant;
 use crate::rules::rng::StepKey;
-use crate::step::block::{Class, Shared, Writable};
-use crate::step::kernel::Kernel;
+use crate::rules::class::Class;
+use crate::step::block::{Shared, Writable};
+use crate::step::block::Kernel;
 use crate::step::partition::Partition;
 use crate::storage::cells::Cells;
 use crate::storage::layout::Layout;

@@ -10,26 +10,10 @@ use crate::Error;
 use crate::api::desc::{Description, Quantization};
 use crate::rules::emitter::Slot;
 use crate::rules::obstacle::Surface;
-use crate::step::block::Class;
+use crate::rules::class::Class;
 use crate::storage::cells::Cells;
+pub(crate) use crate::storage::plain::Plain;
 
-/// Marks plain data that any bit pattern makes valid, so planes of it can be
-/// viewed in the world's bytes.
-///
-/// # Safety
-/// Implementors are `Copy`, have no padding that matters and no invalid bit
-/// patterns.
-pub(crate) unsafe trait Plain: Copy {}
-// SAFETY: primitive integers and floats accept every bit pattern.
-unsafe impl Plain for u8 {}
-unsafe impl Plain for i8 {}
-unsafe impl Plain for u16 {}
-unsafe impl Plain for i16 {}
-unsafe impl Plain for u64 {}
-unsafe impl Plain for f32 {}
-// SAFETY: an array of plain values is plain: no padding between elements,
-// and every element accepts every bit pattern.
-unsafe impl<T: Plain, const N: usize> Plain for [T; N] {}
 // SAFETY: u32 and f32 fields, no padding, every bit pattern valid.
 unsafe impl Plain for Surface {}
 // SAFETY: u32 and f32 fields only, no padding, every bit pattern valid.
