@@ -25,6 +25,15 @@
  * MPCA_STATUS_BUSY, so a call completes before a step begins or is
  * refused. See mpca_world for the whole rule.
  *
+ * Units: length in cells, time in steps. A velocity is in cells per step
+ * (at most 1: the top speed of every world), gravity in cells per step
+ * per step (times dt), an emitter's rate in particles per step, a
+ * lifetime in steps. For a game with cells of h metres running s steps a
+ * second: V m/s is V / (h s) cells per step, A m/s^2 is A / (h s^2), and
+ * T seconds are T s steps; e.g. h = 0.05, s = 120 gives a top speed of
+ * 6 m/s and gravity 9.81 / (0.05 * 120^2) = 0.0136. docs/model.md, Units,
+ * works through water, smoke and sand.
+ *
  * Link, once installed (scripts/install.sh --prefix DIR):
  *   cc app.c $(pkg-config --cflags --libs mpca)
  * or from the build folder: cc app.c -Iinclude -Ltarget/release -lmpca;
@@ -591,7 +600,8 @@ typedef struct mpca_desc {
    */
   uint32_t forces;
   /**
-   * The uniform acceleration.
+   * The uniform acceleration, in cells per step per step (times `dt`):
+   * each step adds `dt * gravity` to every velocity (M5.1).
    */
   float gravity[3];
   /**
@@ -615,7 +625,8 @@ typedef struct mpca_desc {
    */
   float wall_restitution;
   /**
-   * Time step, finite and not negative.
+   * The factor every acceleration and drag rate is scaled by in a step
+   * (M5.1), finite and not negative; 1 by default.
    */
   float dt;
   /**
@@ -654,14 +665,14 @@ typedef struct mpca_desc {
    */
   uint32_t energy_neutral;
   /**
-   * Flow drag rate per unit time (M5.1b), not negative; 0 is off. Each
-   * velocity relaxes towards the flow: v <- (v + dt rate u) / (1 + dt
-   * rate).
+   * Flow drag rate per step, times `dt` (M5.1b), not negative; 0 is
+   * off. Each velocity relaxes towards the flow: v <- (v + dt rate u) /
+   * (1 + dt rate).
    */
   float drag_rate;
   /**
-   * The uniform part of the flow `u`, |drag_wind| <= 1 (decided exactly
-   * for the floats given).
+   * The uniform part of the flow `u`, in cells per step, |drag_wind| <=
+   * 1 (decided exactly for the floats given).
    */
   float drag_wind[3];
   /**
@@ -703,7 +714,7 @@ typedef struct mpca_emitter {
    */
   float rate;
   /**
-   * Initial velocity.
+   * Initial velocity, in cells per step.
    */
   float velocity[3];
   /**

@@ -91,7 +91,8 @@ pub struct mpca_desc {
     pub surface_capacity: u32,
     /// `mpca_force` bits.
     pub forces: u32,
-    /// The uniform acceleration.
+    /// The uniform acceleration, in cells per step per step (times `dt`):
+    /// each step adds `dt * gravity` to every velocity (M5.1).
     pub gravity: [f32; 3],
     /// Vortex centre, in cells.
     pub vortex_centre: [f32; 2],
@@ -103,7 +104,8 @@ pub struct mpca_desc {
     pub restitution: f32,
     /// Restitution of wall faces, in [0, 1].
     pub wall_restitution: f32,
-    /// Time step, finite and not negative.
+    /// The factor every acceleration and drag rate is scaled by in a step
+    /// (M5.1), finite and not negative; 1 by default.
     pub dt: f32,
     /// Bits per stored velocity component: 8 or 16.
     pub quantization: u32,
@@ -124,12 +126,12 @@ pub struct mpca_desc {
     /// adds on average (M1b), so an elastic world keeps its energy. 0:
     /// unbiased rounding only.
     pub energy_neutral: u32,
-    /// Flow drag rate per unit time (M5.1b), not negative; 0 is off. Each
-    /// velocity relaxes towards the flow: v <- (v + dt rate u) / (1 + dt
-    /// rate).
+    /// Flow drag rate per step, times `dt` (M5.1b), not negative; 0 is
+    /// off. Each velocity relaxes towards the flow: v <- (v + dt rate u) /
+    /// (1 + dt rate).
     pub drag_rate: f32,
-    /// The uniform part of the flow `u`, |drag_wind| <= 1 (decided exactly
-    /// for the floats given).
+    /// The uniform part of the flow `u`, in cells per step, |drag_wind| <=
+    /// 1 (decided exactly for the floats given).
     pub drag_wind: [f32; 3],
     /// 1: the vortex (`vortex_*`) read as a velocity field adds to the flow.
     pub drag_vortex: u32,

@@ -16,7 +16,7 @@ pub struct mpca_emitter {
     pub max: [u32; 3],
     /// Mean particles per step, not negative.
     pub rate: f32,
-    /// Initial velocity.
+    /// Initial velocity, in cells per step.
     pub velocity: [f32; 3],
     /// Radius of a uniform random spread added to the velocity;
     /// |velocity| + spread <= 1, decided exactly (no rounding: a sum above 1

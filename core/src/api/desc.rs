@@ -65,9 +65,9 @@ pub enum Collisions {
 /// outside, tangential). A rate of 0 is off. Needs the `fields` feature.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Drag {
-    /// The relaxation rate per unit time, finite and not negative.
+    /// The relaxation rate per step, times `dt`: finite and not negative.
     pub rate: f32,
-    /// A uniform flow velocity, `|wind| <= 1`.
+    /// A uniform flow velocity in cells per step, `|wind| <= 1`.
     pub wind: [f32; 3],
     /// Add a flow velocity per cell to the flow: a plane of `dim` `f32` per
     /// cell, each cell's `|u| <= 1`, zero until set.
@@ -138,7 +138,8 @@ pub struct Description {
     pub surface_capacity: u32,
     /// Which force terms are summed (M5.1).
     pub forces: Forces,
-    /// The uniform acceleration, used when `forces.uniform`.
+    /// The uniform acceleration, used when `forces.uniform`, in cells per
+    /// step per step (times `dt`; `docs/model.md`, Units, maps it to m/s²).
     pub gravity: [f32; 3],
     /// The vortex, used when `forces.vortex`.
     pub vortex: Vortex,
@@ -146,7 +147,8 @@ pub struct Description {
     pub restitution: f32,
     /// Restitution of the domain's wall faces (M4), in `[0, 1]`.
     pub wall_restitution: f32,
-    /// Time step of eqs. 4-5; finite and not negative.
+    /// Time step of eqs. 4-5, the factor a step scales every acceleration
+    /// and drag rate by; finite and not negative.
     pub dt: f32,
     /// The seed of every random stream (M8).
     pub seed: u64,

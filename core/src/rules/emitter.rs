@@ -21,7 +21,7 @@ pub struct Emitter {
     pub max: [u32; 3],
     /// Mean particles per step, finite and not negative.
     pub rate: f32,
-    /// Initial velocity.
+    /// Initial velocity, in cells per step.
     pub velocity: [f32; 3],
     /// Radius of a uniform random spread added to the velocity;
     /// `|velocity| + spread` must not exceed 1 (decided exactly).
