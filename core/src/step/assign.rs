@@ -19,19 +19,25 @@ pub(crate) fn stored_speed2<const D: usize>(q: [i32; D]) -> u32 {
     s
 }
 
+/// The part of the 2D table key (M5.6) that `x` gives, `width` bits a
+/// cell: each cell's field times the cell's place value, summed.
+const fn key_part(x: usize, width: u32) -> u16 {
+    let mut part = 0;
+    let mut c = 0;
+    while c < 4 {
+        part += PLACE_2D[c] * ((x >> (width as usize * c)) & ((1 << width) - 1)) as u16;
+        c += 1;
+    }
+    part
+}
+
 /// Per 2D blocked mask, the part of the table key its cells contribute
 /// (digit 1 each, M5.6); twice it for an occupancy mask (digit 2 + m).
 pub(crate) const BLOCKED_KEY_2D: [u16; 16] = {
     let mut t = [0; 16];
     let mut mask = 0;
     while mask < 16 {
-        let mut c = 0;
-        while c < 4 {
-            if mask >> c & 1 != 0 {
-                t[mask] += PLACE_2D[c];
-            }
-            c += 1;
-        }
+        t[mask] = key_part(mask, 1);
         mask += 1;
     }
     t
@@ -87,11 +93,7 @@ pub(crate) const KEY_2D_WANTS: [u16; 256] = {
     let mut t = [0; 256];
     let mut w = 0;
     while w < 256 {
-        let mut c = 0;
-        while c < 4 {
-            t[w] += PLACE_2D[c] * ((w >> (2 * c)) & 3) as u16;
-            c += 1;
-        }
+        t[w] = key_part(w, 2);
         w += 1;
     }
     t

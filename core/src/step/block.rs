@@ -36,9 +36,9 @@ impl Shared<'_> {
     }
 }
 
-/// The block pipeline (`step/kernel.rs`), specialised once per step (M9) on the stored
-/// velocity type `Q` and the dimension `D` (with `CELLS = 2^D` cells a
-/// block). Summed forces, obstacles, per-particle masses and lifetimes are
+/// The block pipeline (`step/kernel.rs`), specialised once per step (M9)
+/// on the stored velocity type `Q` and the dimension `D` (with
+/// `CELLS = 2^D` cells a block). Summed forces, obstacles, per-particle masses and lifetimes are
 /// per-step switches: each costs a predictable branch per block or per
 /// particle where the pipeline has code for [`Every`] part, and sends every
 /// block there when it is on ([`Shared::plain`]), so the plain
@@ -350,6 +350,8 @@ impl<const D: usize, const CELLS: usize> Stored<D> for Block<D, CELLS> {
         self.dirty |= 1 << c;
     }
 
+    /// The default's value, read in place: through `stored` the cell's
+    /// array is copied first, which takes more flash in the firmware.
     #[inline(always)]
     fn component(&self, i: usize) -> i32 {
         self.v[i / D][i % D]

@@ -16,9 +16,9 @@ use crate::storage::world::Counters;
 /// order of the refused particles' cells: eqs. 7-8 with `R` from the wanted
 /// cell back towards the refused particle's, if it was closing in, then the
 /// clamp to `unit` fine units. `mass_index` holds each cell's mass index,
-/// by the cell the particle started in, where particles carry masses. With `R` fixed, `|d| R` is the length of
-/// `d` (rounded to nearest) times the Q30 axis (M1c): one square root a
-/// contact. Out of line, one copy for both velocity widths: only worlds
+/// by the cell the particle started in, where particles carry masses.
+/// With `R` fixed, `|d| R` is the length of `d` (rounded to nearest) times
+/// the Q30 axis (M1c): one square root a contact. Out of line, one copy for both velocity widths: only worlds
 /// with contacts come here, and they pay one call a block.
 #[inline(never)]
 #[allow(clippy::too_many_arguments)]

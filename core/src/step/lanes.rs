@@ -5,8 +5,8 @@
 //! M5.3's first test is a handful of word operations for the whole block.
 
 use crate::rules::quant::Quant;
-use crate::step::block::Stored;
 use crate::step::assign::per_cell;
+use crate::step::block::Stored;
 use crate::step::partition::BlockRow;
 use crate::storage::cells::Cells;
 

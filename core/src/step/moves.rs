@@ -5,8 +5,7 @@
 
 use crate::rules::quant::Quant;
 use crate::rules::rng::Stream;
-use crate::step::block::{each_occupied, inward_axes, Shared, Stored};
-use crate::step::block::{Carried, Kernel, Parts, Site};
+use crate::step::block::{each_occupied, inward_axes, Carried, Kernel, Parts, Shared, Site, Stored};
 
 impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
     /// M5.3 and M5.4 on the block `b`: the axes each particle wants to

@@ -12,7 +12,7 @@ use crate::rules::emitter::Slot;
 use crate::rules::obstacle::Surface;
 use crate::rules::class::Class;
 use crate::storage::cells::Cells;
-pub(crate) use crate::storage::plain::Plain;
+use crate::storage::plain::Plain;
 
 // SAFETY: u32 and f32 fields, no padding, every bit pattern valid.
 unsafe impl Plain for Surface {}

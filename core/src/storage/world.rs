@@ -11,7 +11,8 @@ use core::mem::{align_of, size_of};
 use crate::Error;
 use crate::api::desc::Description;
 use crate::rules::emitter::Slot;
-use crate::storage::layout::{test_bit, view, view_counted, view_counted_ref, view_ref, Layout, Plain, Planes, Site};
+use crate::storage::layout::{test_bit, view, view_counted, view_counted_ref, view_ref, Layout, Planes, Site};
+use crate::storage::plain::Plain;
 
 /// Counters the step keeps. All integers (clamped energy in 2^-32 units),
 /// so they add up to the same bits in any block order (M8).
