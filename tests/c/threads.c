@@ -131,6 +131,9 @@ static uint64_t step_of(const mpca_world *w) {
 struct reader {
     mpca_world *world;
     struct flag *done;
+    /* Rounds of three reads the reader has finished, whatever they got. */
+    pthread_mutex_t lock;
+    unsigned rounds;
     /* A consistent reading: step count, hash, at that step. */
     uint64_t step[ROUNDS * 4], hash[ROUNDS * 4];
     unsigned readings, torn, busy, other;
@@ -159,11 +162,22 @@ static void *read_loop(void *arg) {
                 r->torn++;
             }
         }
+        pthread_mutex_lock(&r->lock);
+        r->rounds++;
+        pthread_mutex_unlock(&r->lock);
         r->busy += (s1 == MPCA_STATUS_BUSY) + (s2 == MPCA_STATUS_BUSY) + (s3 == MPCA_STATUS_BUSY);
         r->other += (s1 != MPCA_STATUS_OK && s1 != MPCA_STATUS_BUSY) + (s2 != MPCA_STATUS_OK && s2 != MPCA_STATUS_BUSY) +
                     (s3 != MPCA_STATUS_OK && s3 != MPCA_STATUS_BUSY);
     }
     return NULL;
+}
+
+static unsigned rounds_of(struct reader *r) {
+    unsigned n;
+    pthread_mutex_lock(&r->lock);
+    n = r->rounds;
+    pthread_mutex_unlock(&r->lock);
+    return n;
 }
 
 static void readers_and_steps(void) {
@@ -184,6 +198,7 @@ static void readers_and_steps(void) {
     CHECK_OK(mpca_world_hash(w, &seen[0]));
     flag_init(&done);
     memset(&r, 0, sizeof r);
+    pthread_mutex_init(&r.lock, NULL);
     r.world = w;
     r.done = &done;
     if (pthread_create(&thread, NULL, read_loop, &r) != 0) {
@@ -199,8 +214,17 @@ static void readers_and_steps(void) {
             s = mpca_world_hash(w, &seen[steps]);
             other += s != MPCA_STATUS_OK;
             /* A pause between steps, as a program's frame has, in which
-             * the reader may read three times in a row. */
-            sched_yield();
+             * the reader reads three times in a row: until it has finished
+             * a round begun after this step (the one under way may have
+             * begun before). Without it the reader's three calls outlast
+             * the main thread's one on a loaded machine, and a step
+             * refuses the third every time. */
+            {
+                unsigned start = rounds_of(&r), spins = 0;
+                while (rounds_of(&r) < start + 2 && spins++ < PATIENCE) {
+                    sched_yield();
+                }
+            }
         } else if (s == MPCA_STATUS_BUSY) {
             busy++;
         } else {
