@@ -47,7 +47,7 @@ use crate::rules::emitter::{checked, Emitter, Slot};
 use crate::rules::obstacle::Surface;
 use crate::rules::quant::{with_quant, Quant};
 use crate::storage::cells::Cells;
-use crate::storage::layout::{mark, Layout};
+use crate::storage::layout::{mark, store, Layout};
 use crate::storage::world::{Counters, World};
 
 /// The first eight bytes of every image.
@@ -109,12 +109,18 @@ impl Put<'_> {
         self.out[self.at..self.at + b.len()].copy_from_slice(b);
         self.at += b.len();
     }
+    // Out of line, the value in a register: the image's fields are many,
+    // and each bounds check and copy inlined where it is written made most
+    // of the writer's code.
+    #[inline(never)]
     fn u8(&mut self, v: u8) {
         self.bytes(&[v]);
     }
+    #[inline(never)]
     fn u32(&mut self, v: u32) {
         self.bytes(&v.to_le_bytes());
     }
+    #[inline(never)]
     fn u64(&mut self, v: u64) {
         self.bytes(&v.to_le_bytes());
     }
@@ -633,8 +639,10 @@ fn apply(w: &mut World, img: &Image<'_>) {
     w.head.masses = img.masses as u32;
     w.head.surfaces = img.surfaces as u32;
     w.head.emitters = img.emitters as u32;
-    with_quant!(d.quantization, Q => {
-        let (_, p) = w.planes::<Q>();
+    // The velocities as bytes, written component by component in the
+    // world's width (`store`): one copy of this for both widths.
+    {
+        let (_, p) = w.planes::<u8>();
         for (i, word) in p.occupancy.iter_mut().enumerate() {
             *word = le_u64(img.occupancy, i);
         }
@@ -643,20 +651,20 @@ fn apply(w: &mut World, img: &Image<'_>) {
         }
         // Values in empty cells are never read; zero, so that equal images
         // make equal memory.
-        p.velocity.fill(Q::default());
+        p.velocity.fill(0);
         p.mass_index.fill(0);
         p.life.fill(0);
         // The skip summaries (M3), exact: flagged where a particle is.
         p.rows.fill(0);
         p.words.fill(0);
         let (rows, words) = (Cells::new(&mut *p.rows), Cells::new(&mut *p.words));
-        let width = size_of::<Q>();
+        let (width, scale) = width_and_scale(d.quantization);
         let mut i = 0;
         each_bit(&l, |k| le_u64(img.occupancy, k), |row, x| {
             mark(rows, words, l.summary_words, row, x);
             let cell = x + l.n[0] * row;
             for k in 0..dim {
-                p.velocity[cell * dim + k] = Q::from_int(component(&img.velocity[(i * dim + k) * width..], width));
+                store(p.velocity, cell * dim + k, width, component(&img.velocity[(i * dim + k) * width..], width).clamp(-scale, scale));
             }
             if d.per_particle_mass {
                 p.mass_index[cell] = img.mass_index[i];
@@ -683,7 +691,16 @@ fn apply(w: &mut World, img: &Image<'_>) {
         for (s, b) in p.emitters.iter_mut().zip(img.emitter.chunks_exact(EMITTER)) {
             *s = get_slot(b);
         }
-    });
+    }
+}
+
+/// The set bits of `words`: the particles of an occupancy plane. Out of
+/// line: on targets without a population count instruction the sum is
+/// unrolled into much code, which every caller of
+/// [`World::snapshot_bytes`] would hold.
+#[inline(never)]
+fn ones(words: &[u64]) -> usize {
+    words.iter().map(|w| w.count_ones() as usize).sum()
 }
 
 /// The description of the world `image` holds, after checking the whole
@@ -700,7 +717,7 @@ impl World {
     pub fn snapshot_bytes(&self) -> usize {
         let h = &self.head;
         let occupancy: &[u64] = self.plane(h.layout.occupancy());
-        let particles = occupancy.iter().map(|w| w.count_ones() as usize).sum();
+        let particles = ones(occupancy);
         image_len(&h.desc, &h.layout, particles, h.masses as usize, h.surfaces as usize, h.emitters as usize).unwrap_or(usize::MAX)
     }
 

@@ -289,6 +289,19 @@ pub(crate) struct Site {
     pub x: usize,
 }
 
+/// Writes stored component `i` of a velocity plane of `width`-byte
+/// components (1, or 2 in the target's byte order) viewed as bytes: `q`,
+/// in quanta, within the width's range. Callers that hold the plane as
+/// bytes have one copy of their code for both widths.
+#[inline]
+pub(crate) fn store(plane: &mut [u8], i: usize, width: usize, q: i32) {
+    if width == 1 || !cfg!(feature = "q16") {
+        plane[i] = q as i8 as u8;
+    } else {
+        plane[2 * i..2 * i + 2].copy_from_slice(&(q as i16).to_ne_bytes());
+    }
+}
+
 /// Notes that cell `x` of row `row` now holds a particle: sets the row's
 /// flag and its summary bit for the occupancy word holding the cell, so the
 /// step does not skip them (M3). `summary_words` words per row.
