@@ -121,6 +121,17 @@ void draw_density_2d(mpca_world *w, uint32_t bin, float full) {
     gpu_draw_density_2d(g, mvp, d.size[0], d.size[1], bg, full);
 }
 
+void upload_motion_2d(const float *from, const float *to, const uint32_t *ages, size_t n) {
+    gpu_upload_motion_2d(gpu_of_canvas(), from, to, ages, n);
+}
+
+void draw_motion_2d(float blend, float lifetime, float sprite_px, float peak) {
+    const gpu_smoke s = {blend, lifetime, sprite_px, peak};
+    float mvp[16];
+    current_mvp(mvp);
+    gpu_draw_smoke_2d(gpu_of_canvas(), mvp, &s);
+}
+
 void draw_walls_2d(const mpca_desc *desc, const view *v) {
     /* In pixels, so the line is two pixels wide at any cell size. */
     float wpx = (float)v->width, hpx = (float)v->height;

@@ -60,6 +60,14 @@ size_t draw_particles_2d(mpca_world *w, const view *v);
  * and drawn over the whole view as grey haze (gpu.h), brightest where a
  * bin's share of occupied cells is `full` or more. */
 void draw_density_2d(mpca_world *w, uint32_t bin, float full);
+/* 2D, once a step: the particles' cell centres before the step and after
+ * it (2 floats each) and their ages, into a vertex buffer (gpu.h,
+ * gpu_upload_motion_2d). */
+void upload_motion_2d(const float *from, const float *to, const uint32_t *ages, size_t n);
+/* 2D: the uploaded particles as soft puffs of `sprite_px` pixels at
+ * `blend` (0 to 1) between their two cells, fading out over `lifetime`
+ * steps of age (gpu.h, gpu_draw_smoke_2d). */
+void draw_motion_2d(float blend, float lifetime, float sprite_px, float peak);
 /* 2D: the faces of the domain that are walls, as grey lines two pixels
  * wide along the image border. */
 void draw_walls_2d(const mpca_desc *desc, const view *v);

@@ -110,6 +110,42 @@ static const char *const DENSITY_FS =
     "    gl_FragColor = vec4(mix(bg, vec3(0.45), a), 1.0);\n"
     "}\n";
 
+/* Motion between two steps, one vertex per particle: its cell centre
+ * before the step (motion.xy) and after it (motion.zw), and its age after
+ * the step. `blend` runs from 0 (before) to 1 (after), so the points slide
+ * between cells instead of jumping a whole cell a step; the age slides with
+ * them, from age - 1 to age. */
+static const char *const SMOKE_2D_VS =
+    "#version 120\n"
+    "uniform mat4 mvp;\n"
+    "uniform float blend, lifetime, sprite_px;\n"
+    "attribute vec4 motion;\n"
+    "attribute float age;\n"
+    "varying float lived;\n"
+    "void main() {\n"
+    "    gl_Position = mvp * vec4(mix(motion.xy, motion.zw, blend), 0.0, 1.0);\n"
+    "    gl_PointSize = sprite_px;\n"
+    "    lived = clamp((age - 1.0 + blend) / lifetime, 0.0, 1.0);\n"
+    "}\n";
+
+/* A soft puff: alpha falls from the centre to 0 at the rim as 1 - r^2,
+ * and with the share of its lifetime lived, so old smoke thins out and is
+ * gone by the time the library removes it. Its colour cools with age
+ * along the palette. */
+static const char *const SMOKE_2D_FS =
+    "#version 120\n"
+    "uniform sampler2D palette;\n"
+    "uniform float stops, peak;\n"
+    "varying float lived;\n"
+    "void main() {\n"
+    "    vec2 p = 2.0 * gl_PointCoord - 1.0;\n"
+    "    float r2 = dot(p, p);\n"
+    "    if (r2 > 1.0) discard;\n"
+    "    float u = (0.5 + lived * (stops - 1.0)) / stops;\n"
+    "    float a = peak * (1.0 - r2) * (1.0 - lived);\n"
+    "    gl_FragColor = vec4(texture2D(palette, vec2(u, 0.5)).rgb, a);\n"
+    "}\n";
+
 /* ---- GL helpers --------------------------------------------------------- */
 
 static void gl_check(const char *what) {
@@ -135,8 +171,9 @@ static GLuint compile(GLenum kind, const char *source, const char *name) {
     return shader;
 }
 
-/* A program from two shaders; attribute 0 is `position` (or `corner`), 1
- * is `velocity`, bound before linking so every program agrees. */
+/* A program from two shaders; attribute 0 is `position` (or `corner`, or
+ * `motion`), 1 is `velocity` (or `age`), bound before linking so every
+ * program agrees. */
 static GLuint link(const char *vs, const char *fs, const char *name) {
     GLuint program = glCreateProgram();
     GLuint v = compile(GL_VERTEX_SHADER, vs, name), f = compile(GL_FRAGMENT_SHADER, fs, name);
@@ -144,7 +181,9 @@ static GLuint link(const char *vs, const char *fs, const char *name) {
     glAttachShader(program, f);
     glBindAttribLocation(program, 0, "position");
     glBindAttribLocation(program, 0, "corner");
+    glBindAttribLocation(program, 0, "motion");
     glBindAttribLocation(program, 1, "velocity");
+    glBindAttribLocation(program, 1, "age");
     glLinkProgram(program);
     glDeleteShader(v); /* freed with the program */
     glDeleteShader(f);
@@ -176,12 +215,15 @@ static GLuint palette_texture(const uint8_t (*stops)[3], int n) {
 /* ---- the object ----------------------------------------------------------- */
 
 struct gpu {
-    GLuint points_2d, sprites_3d, density_program;
+    GLuint points_2d, sprites_3d, density_program, smoke_2d;
     /* Positions in the first half (3 * capacity floats), velocities in the
      * second. */
     GLuint particles;
     size_t capacity, count;
-    GLuint palette_2d, palette_3d;
+    GLuint palette_2d, palette_3d, palette_smoke;
+    /* 5 floats a particle: before and after a step, and the age. */
+    GLuint motion;
+    size_t motion_capacity, motion_count;
     GLuint quad;                 /* the corners (0,0) to (1,1) */
     GLuint density;              /* a LUMINANCE texture of res[0] x res[1] */
     GLsizei res[2];
@@ -196,17 +238,26 @@ static const uint8_t PALETTE_2D[5][3] = {
 };
 /* Water: dark blue to light cyan. */
 static const uint8_t PALETTE_3D[3][3] = {{25, 80, 215}, {40, 160, 240}, {150, 235, 255}};
+/* Smoke by age: hot yellow, orange, red, cooling to violet. Saturated, as
+ * every particle colour is, though a faded puff over the background is
+ * not. */
+static const uint8_t PALETTE_SMOKE[4][3] = {{255, 214, 110}, {245, 135, 55}, {200, 65, 100}, {110, 85, 200}};
 
 gpu *gpu_create(void) {
     gpu *g = xrealloc(NULL, sizeof *g);
     g->points_2d = link(POINTS_2D_VS, POINTS_2D_FS, "points_2d");
     g->sprites_3d = link(SPRITES_3D_VS, SPRITES_3D_FS, "sprites_3d");
     g->density_program = link(DENSITY_VS, DENSITY_FS, "density");
+    g->smoke_2d = link(SMOKE_2D_VS, SMOKE_2D_FS, "smoke_2d");
     glGenBuffers(1, &g->particles);
+    glGenBuffers(1, &g->motion);
+    g->motion_capacity = 0;
+    g->motion_count = 0;
     g->capacity = 0;
     g->count = 0;
     g->palette_2d = palette_texture(PALETTE_2D, 5);
     g->palette_3d = palette_texture(PALETTE_3D, 3);
+    g->palette_smoke = palette_texture(PALETTE_SMOKE, 4);
     static const GLfloat corners[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
     glGenBuffers(1, &g->quad);
     glBindBuffer(GL_ARRAY_BUFFER, g->quad);
@@ -224,10 +275,11 @@ void gpu_destroy(gpu *g) {
     glDeleteProgram(g->points_2d);
     glDeleteProgram(g->sprites_3d);
     glDeleteProgram(g->density_program);
-    GLuint buffers[2] = {g->particles, g->quad};
-    glDeleteBuffers(2, buffers);
-    GLuint textures[3] = {g->palette_2d, g->palette_3d, g->density};
-    glDeleteTextures(3, textures);
+    glDeleteProgram(g->smoke_2d);
+    GLuint buffers[3] = {g->particles, g->quad, g->motion};
+    glDeleteBuffers(3, buffers);
+    GLuint textures[4] = {g->palette_2d, g->palette_3d, g->palette_smoke, g->density};
+    glDeleteTextures(4, textures);
     free(g->density_bytes);
     free(g);
 }
@@ -320,6 +372,74 @@ void gpu_draw_sprites_3d(gpu *g, const float mvp[16], const gpu_sprites *s) {
     draw_particles(g, p, g->palette_3d, 3);
     glDisable(GL_POINT_SPRITE);
     gl_check("gpu_draw_sprites_3d");
+}
+
+/* ---- motion between steps ---------------------------------------------------- */
+
+void gpu_upload_motion_2d(gpu *g, const float *from, const float *to, const uint32_t *ages, size_t n) {
+    if (n > g->motion_capacity || g->motion_capacity == 0) g->motion_capacity = n + n / 2 + 64;
+    glBindBuffer(GL_ARRAY_BUFFER, g->motion);
+    /* Orphaned, as the particle buffer is (gpu_upload_particles). */
+    glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(5 * g->motion_capacity * sizeof(float)), NULL, GL_STREAM_DRAW);
+    float *mapped = glMapBuffer(GL_ARRAY_BUFFER, GL_WRITE_ONLY);
+    if (!mapped) {
+        fprintf(stderr, "glMapBuffer failed (0x%x)\n", (unsigned)glGetError());
+        exit(1);
+    }
+    for (size_t i = 0; i < n; i++) {
+        float *v = mapped + 5 * i;
+        v[0] = from[2 * i];
+        v[1] = from[2 * i + 1];
+        v[2] = to[2 * i];
+        v[3] = to[2 * i + 1];
+        v[4] = (float)ages[i];
+    }
+    GLboolean intact = glUnmapBuffer(GL_ARRAY_BUFFER);
+    glBindBuffer(GL_ARRAY_BUFFER, 0);
+    if (!intact) {
+        /* The storage was lost while mapped: upload again. */
+        gpu_upload_motion_2d(g, from, to, ages, n);
+        return;
+    }
+    g->motion_count = n;
+    gl_check("gpu_upload_motion_2d");
+}
+
+void gpu_draw_smoke_2d(gpu *g, const float mvp[16], const gpu_smoke *s) {
+    if (g->motion_count == 0) return;
+    GLuint p = g->smoke_2d;
+    glUseProgram(p);
+    glUniformMatrix4fv(glGetUniformLocation(p, "mvp"), 1, GL_FALSE, mvp);
+    glUniform1f(glGetUniformLocation(p, "blend"), s->blend);
+    glUniform1f(glGetUniformLocation(p, "lifetime"), s->lifetime > 0.0f ? s->lifetime : 1.0f);
+    glUniform1f(glGetUniformLocation(p, "sprite_px"), s->sprite_px);
+    glUniform1f(glGetUniformLocation(p, "peak"), s->peak);
+    glUniform1i(glGetUniformLocation(p, "palette"), 0);
+    glUniform1f(glGetUniformLocation(p, "stops"), 4.0f);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, g->palette_smoke);
+    glBindBuffer(GL_ARRAY_BUFFER, g->motion);
+    glEnableVertexAttribArray(0);
+    glEnableVertexAttribArray(1);
+    const GLsizei stride = 5 * sizeof(float);
+    glVertexAttribPointer(0, 4, GL_FLOAT, GL_FALSE, stride, (const void *)0);
+    glVertexAttribPointer(1, 1, GL_FLOAT, GL_FALSE, stride, (const void *)(4 * sizeof(float)));
+    /* Puffs overlap: each is laid over what is there by its alpha, so
+     * where many meet the smoke is thick. */
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+    glEnable(GL_VERTEX_PROGRAM_POINT_SIZE);
+    glEnable(GL_POINT_SPRITE);
+    glDrawArrays(GL_POINTS, 0, (GLsizei)g->motion_count);
+    glDisable(GL_POINT_SPRITE);
+    glDisable(GL_VERTEX_PROGRAM_POINT_SIZE);
+    glDisable(GL_BLEND);
+    glDisableVertexAttribArray(1);
+    glDisableVertexAttribArray(0);
+    glBindBuffer(GL_ARRAY_BUFFER, 0);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    glUseProgram(0);
+    gl_check("gpu_draw_smoke_2d");
 }
 
 /* ---- density --------------------------------------------------------------- */

@@ -60,6 +60,24 @@ typedef struct gpu_sprites {
  * distance. Depth-tested against what is drawn already. */
 void gpu_draw_sprites_3d(gpu *g, const float mvp[16], const gpu_sprites *s);
 
+/* 2D, once a step: `n` particles' cell centres before the step (`from`)
+ * and after it (`to`), 2 floats each, and their ages after it, into the
+ * motion buffer (c_examples/smoke-ids.c matches the two by id). */
+void gpu_upload_motion_2d(gpu *g, const float *from, const float *to, const uint32_t *ages, size_t n);
+
+/* 2D: how the uploaded motion is drawn, any number of times a step. */
+typedef struct gpu_smoke {
+    float blend;     /* where between the two steps: 0 before, 1 after */
+    float lifetime;  /* steps; a puff fades out over them */
+    float sprite_px; /* a puff's diameter in pixels */
+    float peak;      /* a new puff's alpha at its centre */
+} gpu_smoke;
+
+/* 2D: the uploaded particles as soft round puffs at `blend` between
+ * their two positions, alpha-blended over what is drawn already, fading
+ * and cooling in colour (yellow, orange, red, violet) with age. */
+void gpu_draw_smoke_2d(gpu *g, const float mvp[16], const gpu_smoke *s);
+
 /* 2D: the world's density in bins of `bin` x `bin` cells into the density
  * texture (the world's size must be a multiple of `bin`). */
 void gpu_upload_density_2d(gpu *g, const mpca_world *w, uint32_t bin);

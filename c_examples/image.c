@@ -86,10 +86,11 @@ static const uint8_t *glyph(char ch) {
         {7, 5, 5, 5, 7}, {2, 6, 2, 2, 7}, {7, 1, 7, 4, 7}, {7, 1, 7, 1, 7}, {5, 5, 7, 1, 1},
         {7, 4, 7, 1, 7}, {7, 4, 7, 5, 7}, {7, 1, 1, 1, 1}, {7, 5, 7, 5, 7}, {7, 5, 7, 1, 7},
     };
-    static const uint8_t t[5] = {2, 7, 2, 2, 3}, eq[5] = {0, 7, 0, 7, 0}, blank[5] = {0};
+    static const uint8_t t[5] = {2, 7, 2, 2, 3}, eq[5] = {0, 7, 0, 7, 0}, dot[5] = {0, 0, 0, 0, 2}, blank[5] = {0};
     if (ch >= '0' && ch <= '9') return digits[ch - '0'];
     if (ch == 't') return t;
     if (ch == '=') return eq;
+    if (ch == '.') return dot;
     return blank;
 }
 

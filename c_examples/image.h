@@ -31,7 +31,7 @@ void image_clear(image *im);
  * with its top left corner at (x0, y0). */
 void image_blit_gl(image *dst, const uint8_t *gl_rgba, uint32_t w, uint32_t h, uint32_t x0, uint32_t y0);
 
-/* Labels: digits, 't' and '=' in grey, LABEL_HEIGHT pixels tall. */
+/* Labels: digits, 't', '=' and '.' in grey, LABEL_HEIGHT pixels tall. */
 #define LABEL_SCALE 2
 #define LABEL_HEIGHT (5 * LABEL_SCALE)
 /* Draws `text` with its top left corner at (x0, y0). */

@@ -82,8 +82,7 @@ static void run_tasks(mpca_world *world, uint64_t ticket, uint32_t count, void *
     pthread_mutex_destroy(&b.lock);
 }
 
-/* Steps `w` on `n` steps as the options say. */
-static void step_world(mpca_world *w, uint64_t n, const scene_opts *o) {
+void scene_step(mpca_world *w, uint64_t n, const scene_opts *o) {
     if (o->threads == 0) {
         mpca_check(mpca_world_step(w, n), "mpca_world_step");
     } else {
@@ -92,8 +91,7 @@ static void step_world(mpca_world *w, uint64_t n, const scene_opts *o) {
     }
 }
 
-/* mkdir -p */
-static void make_dirs(const char *path) {
+void scene_make_dirs(const char *path) {
     char *p = xrealloc(NULL, strlen(path) + 1);
     strcpy(p, path);
     for (char *c = p + 1;; c++) {
@@ -113,10 +111,6 @@ static void make_dirs(const char *path) {
 
 /* ---- the loop ------------------------------------------------------------------- */
 
-/* Gap between the contact sheet's tiles, in pixels. */
-#define SHEET_GAP 6
-/* Margin of a GIF frame's label, in pixels. */
-#define GIF_GAP 4
 /* 12.5 frames a second, and a second on the last before it loops. */
 #define GIF_DELAY_CS 8
 #define GIF_LAST_DELAY_CS 100
@@ -157,9 +151,7 @@ static void print_drawn(const drawn *d, const view *v) {
     }
 }
 
-/* Step i of n spread evenly over 0..steps, both ends included:
- * round(i * steps / (n - 1)); the end alone when n is 1. */
-static uint64_t spread(uint64_t i, uint64_t n, uint64_t steps) {
+uint64_t scene_spread(uint64_t i, uint64_t n, uint64_t steps) {
     return n <= 1 ? steps : (steps * i + (n - 1) / 2) / (n - 1);
 }
 
@@ -200,11 +192,61 @@ static uint64_t progress_next(const progress *p, uint64_t steps) {
 
 /* ---- the run -------------------------------------------------------------------- */
 
+void scene_frame_png(image *frame, const uint8_t *gl, const view *fv, const scene_opts *o, int digits, uint64_t n,
+                     char *path, size_t path_len) {
+    image_blit_gl(frame, gl, fv->width, fv->height, 0, 0);
+    snprintf(path, path_len, "%s/%s-frame-%0*llu.png", o->out, o->name, digits, (unsigned long long)n);
+    png_write(path, frame, (int)o->png_level);
+}
+
+void scene_tile(image *sheet, const uint8_t *gl, const view *tv, uint64_t i, const char *label) {
+    uint32_t x0 = SHEET_GAP + (uint32_t)i * (tv->width + SHEET_GAP);
+    image_blit_gl(sheet, gl, tv->width, tv->height, x0, SHEET_GAP);
+    image_label(sheet, x0, tv->height + 2 * SHEET_GAP, label);
+}
+
+void scene_gif_frame(gif_anim *gif, image *frame, const uint8_t *gl, const view *tv, const char *label) {
+    image_clear(frame);
+    image_blit_gl(frame, gl, tv->width, tv->height, 0, 0);
+    image_label(frame, GIF_GAP, tv->height + GIF_GAP, label);
+    gif_add(gif, frame);
+}
+
+double scene_finish(const scene_opts *o, const image *sheet, unsigned tiles, gif_anim *gif, const image *gif_frame,
+                    int delay_cs, int last_delay_cs, mpca_world *w, mpca_stats *stats) {
+    size_t path_len = strlen(o->out) + strlen(o->name) + 48;
+    char *path = xrealloc(NULL, path_len);
+    double t0 = now_s();
+    snprintf(path, path_len, "%s/%s-sheet.png", o->out, o->name);
+    png_write(path, sheet, (int)o->png_level);
+    double png_s = now_s() - t0;
+    printf("sheet: %s size=%ux%u tiles=%u\n", path, (unsigned)sheet->width, (unsigned)sheet->height, tiles);
+    if (gif) {
+        t0 = now_s();
+        snprintf(path, path_len, "%s/%s.gif", o->out, o->name);
+        gif_written g = gif_write(gif, path, delay_cs, last_delay_cs);
+        printf("gif: %s size=%ux%u frames=%u colours=%u bytes=%ld in %.1f ms\n", path, (unsigned)gif_frame->width,
+               (unsigned)gif_frame->height, (unsigned)g.frames, (unsigned)g.colours, g.bytes, 1e3 * (now_s() - t0));
+        gif_free(gif);
+    }
+    free(path);
+
+    mpca_check(mpca_world_stats(w, stats), "mpca_world_stats");
+    uint64_t hash = 0;
+    mpca_check(mpca_world_hash(w, &hash), "mpca_world_hash");
+    printf("end: step=%llu particles=%llu emitted=%llu shortfall=%llu exited=%llu collisions=%llu clamps=%llu "
+           "hash=%016llx\n",
+           (unsigned long long)stats->step, (unsigned long long)stats->particles, (unsigned long long)stats->emitted,
+           (unsigned long long)stats->emit_shortfall, (unsigned long long)stats->exited,
+           (unsigned long long)stats->collisions, (unsigned long long)stats->clamps, (unsigned long long)hash);
+    return png_s;
+}
+
 int scene_main(const scene *s, int argc, char **argv) {
     scene_opts o;
     int status = options_parse(s, &o, argc, argv);
     if (status >= 0) return status;
-    make_dirs(o.out);
+    scene_make_dirs(o.out);
 
     mpca_world *w = s->build(&o);
     mpca_stats stats = {.struct_size = sizeof stats};
@@ -260,9 +302,7 @@ int scene_main(const scene *s, int argc, char **argv) {
             double t0 = now_s();
             drawn d = render(s, &o, w, c, frame_gl, &fv);
             double t1 = now_s();
-            image_blit_gl(&frame, frame_gl, fv.width, fv.height, 0, 0);
-            snprintf(path, path_len, "%s/%s-frame-%0*llu.png", o.out, o.name, digits, (unsigned long long)frames);
-            png_write(path, &frame, (int)o.png_level);
+            scene_frame_png(&frame, frame_gl, &fv, &o, digits, frames, path, path_len);
             draw_s += t1 - t0;
             png_s += now_s() - t1;
             images++;
@@ -271,8 +311,8 @@ int scene_main(const scene *s, int argc, char **argv) {
             printf("frame: %s step=%llu", path, (unsigned long long)t);
             print_drawn(&d, &fv);
         }
-        int tile_now = next_tile < tiles && spread(next_tile, tiles, o.steps) == t;
-        int gif_now = next_gif < gif_frames && spread(next_gif, gif_frames, o.steps) == t;
+        int tile_now = next_tile < tiles && scene_spread(next_tile, tiles, o.steps) == t;
+        int gif_now = next_gif < gif_frames && scene_spread(next_gif, gif_frames, o.steps) == t;
         if (tile_now || gif_now) {
             /* One drawing serves both. */
             double t0 = now_s();
@@ -280,18 +320,13 @@ int scene_main(const scene *s, int argc, char **argv) {
             draw_s += now_s() - t0;
             images++;
             if (tile_now) {
-                uint32_t x0 = SHEET_GAP + (uint32_t)next_tile * (tv.width + SHEET_GAP);
-                image_blit_gl(&sheet, tile_gl, tv.width, tv.height, x0, SHEET_GAP);
-                image_label(&sheet, x0, tv.height + 2 * SHEET_GAP, label);
+                scene_tile(&sheet, tile_gl, &tv, next_tile, label);
                 printf("tile: step=%llu", (unsigned long long)t);
                 print_drawn(&d, &tv);
                 next_tile++;
             }
             if (gif_now) {
-                image_clear(&gif_frame);
-                image_blit_gl(&gif_frame, tile_gl, tv.width, tv.height, 0, 0);
-                image_label(&gif_frame, GIF_GAP, tv.height + GIF_GAP, label);
-                gif_add(gif, &gif_frame);
+                scene_gif_frame(gif, &gif_frame, tile_gl, &tv, label);
                 next_gif++;
             }
         }
@@ -302,38 +337,19 @@ int scene_main(const scene *s, int argc, char **argv) {
          * timing only the steps. */
         uint64_t next = o.steps;
         if (o.every && (t / o.every + 1) * o.every < next) next = (t / o.every + 1) * o.every;
-        if (next_tile < tiles && spread(next_tile, tiles, o.steps) < next) next = spread(next_tile, tiles, o.steps);
-        if (next_gif < gif_frames && spread(next_gif, gif_frames, o.steps) < next) {
-            next = spread(next_gif, gif_frames, o.steps);
+        if (next_tile < tiles && scene_spread(next_tile, tiles, o.steps) < next) {
+            next = scene_spread(next_tile, tiles, o.steps);
+        }
+        if (next_gif < gif_frames && scene_spread(next_gif, gif_frames, o.steps) < next) {
+            next = scene_spread(next_gif, gif_frames, o.steps);
         }
         if (progress_next(&prog, o.steps) < next) next = progress_next(&prog, o.steps);
         double t0 = now_s();
-        step_world(w, next - t, &o);
+        scene_step(w, next - t, &o);
         sim_s += now_s() - t0;
         t = next;
     }
-    double t0 = now_s();
-    snprintf(path, path_len, "%s/%s-sheet.png", o.out, o.name);
-    png_write(path, &sheet, (int)o.png_level);
-    png_s += now_s() - t0;
-    printf("sheet: %s size=%ux%u tiles=%u\n", path, (unsigned)sheet.width, (unsigned)sheet.height, (unsigned)tiles);
-    if (gif) {
-        t0 = now_s();
-        snprintf(path, path_len, "%s/%s.gif", o.out, o.name);
-        gif_written g = gif_write(gif, path, GIF_DELAY_CS, GIF_LAST_DELAY_CS);
-        printf("gif: %s size=%ux%u frames=%u colours=%u bytes=%ld in %.1f ms\n", path, (unsigned)gif_frame.width,
-               (unsigned)gif_frame.height, (unsigned)g.frames, (unsigned)g.colours, g.bytes, 1e3 * (now_s() - t0));
-        gif_free(gif);
-    }
-
-    mpca_check(mpca_world_stats(w, &stats), "mpca_world_stats");
-    uint64_t hash = 0;
-    mpca_check(mpca_world_hash(w, &hash), "mpca_world_hash");
-    printf("end: step=%llu particles=%llu emitted=%llu shortfall=%llu exited=%llu collisions=%llu clamps=%llu "
-           "hash=%016llx\n",
-           (unsigned long long)stats.step, (unsigned long long)stats.particles, (unsigned long long)stats.emitted,
-           (unsigned long long)stats.emit_shortfall, (unsigned long long)stats.exited,
-           (unsigned long long)stats.collisions, (unsigned long long)stats.clamps, (unsigned long long)hash);
+    png_s += scene_finish(&o, &sheet, (unsigned)tiles, gif, &gif_frame, GIF_DELAY_CS, GIF_LAST_DELAY_CS, w, &stats);
     double per_step = o.steps ? 1e3 * sim_s / (double)o.steps : 0.0;
     printf("sim: %.3f ms/step (%llu steps in %.1f ms), render: %.2f ms/frame (%llu frames and tiles), "
            "png: %.2f ms/file (%llu files)\n",

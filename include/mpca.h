@@ -145,6 +145,10 @@ enum mpca_status
    */
   MPCA_STATUS_OVERLAP = 12,
   /**
+   * A tag is above 255: tags are one byte (M6b).
+   */
+  MPCA_STATUS_TAG_RANGE = 13,
+  /**
    * The dimension is neither 2 nor 3.
    */
   MPCA_STATUS_BAD_DIMENSION = 100,
@@ -307,6 +311,11 @@ enum mpca_status
    */
   MPCA_STATUS_BAD_DRAG = 140,
   /**
+   * Every particle id of the world's life was given: no particle can be
+   * added, and emitters count what they ask for as shortfall (M6b).
+   */
+  MPCA_STATUS_IDS_EXHAUSTED = 141,
+  /**
    * An error this version of the C ABI does not know by name.
    */
   MPCA_STATUS_UNKNOWN = 199,
@@ -459,6 +468,37 @@ enum mpca_force
 typedef enum mpca_force mpca_force;
 #else
 typedef uint32_t mpca_force;
+#endif // __STDC_VERSION__ >= 202311L
+#endif // __cplusplus
+
+/**
+ * Bits of `mpca_desc.identity` (M6b): the planes carried with every
+ * particle.
+ */
+enum mpca_identity
+#if defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+  : uint32_t
+#endif // defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+ {
+  /**
+   * A 32-bit id, unique in the world's life, from 1 (4 bytes a cell).
+   */
+  MPCA_IDENTITY_IDS = 1,
+  /**
+   * The steps each particle has taken part in (4 bytes a cell).
+   */
+  MPCA_IDENTITY_AGES = 2,
+  /**
+   * A byte of the caller's: mpca_world_set_tag, mpca_world_set_emitter_tag
+   * (1 byte a cell).
+   */
+  MPCA_IDENTITY_TAGS = 4,
+};
+#ifndef __cplusplus
+#if __STDC_VERSION__ >= 202311L
+typedef enum mpca_identity mpca_identity;
+#else
+typedef uint32_t mpca_identity;
 #endif // __STDC_VERSION__ >= 202311L
 #endif // __cplusplus
 
@@ -686,11 +726,10 @@ typedef struct mpca_desc {
    */
   uint32_t drag_wind_field;
   /**
-   * 0: room a later version may give a meaning, so that the structure
-   * has no padding (whole structures compare with memcmp). Anything
-   * else is refused with MPCA_STATUS_BAD_ENUM.
+   * `mpca_identity` bits: ids, ages and tags carried with the particles
+   * (M6b); 0, none, by default.
    */
-  uint32_t reserved;
+  uint32_t identity;
 } mpca_desc;
 
 /**
@@ -766,6 +805,19 @@ typedef struct mpca_particle {
    * Steps left to live, 0 for no limit.
    */
   uint32_t life;
+  /**
+   * Its id, unique in the world's life, from 1 (M6b); 0 in a world
+   * without MPCA_IDENTITY_IDS.
+   */
+  uint32_t id;
+  /**
+   * The steps it has taken part in; 0 without MPCA_IDENTITY_AGES.
+   */
+  uint32_t age;
+  /**
+   * The caller's tag, 0 to 255; 0 without MPCA_IDENTITY_TAGS.
+   */
+  uint32_t tag;
 } mpca_particle;
 
 /**
@@ -781,6 +833,44 @@ typedef struct mpca_cell {
    */
   struct mpca_particle particle;
 } mpca_cell;
+
+/**
+ * Where mpca_world_export_particles writes, a column per quantity: each
+ * NULL or an array with room for `capacity` particles. Set `struct_size`
+ * to `sizeof(mpca_particle_columns)`.
+ */
+typedef struct mpca_particle_columns {
+  /**
+   * `sizeof(mpca_particle_columns)`.
+   */
+  uint32_t struct_size;
+  /**
+   * 0: room a later version may give a meaning (no padding before the
+   * pointers). Anything else is refused with MPCA_STATUS_BAD_ENUM.
+   */
+  uint32_t reserved;
+  /**
+   * 3 floats a particle: the cell's centre, as
+   * mpca_world_export_positions writes.
+   */
+  float *positions;
+  /**
+   * 3 floats a particle: the velocity in cells per step.
+   */
+  float *velocities;
+  /**
+   * One a particle: its id (needs MPCA_IDENTITY_IDS).
+   */
+  uint32_t *ids;
+  /**
+   * One a particle: its age in steps (needs MPCA_IDENTITY_AGES).
+   */
+  uint32_t *ages;
+  /**
+   * One a particle: its tag (needs MPCA_IDENTITY_TAGS).
+   */
+  uint8_t *tags;
+} mpca_particle_columns;
 
 /**
  * Statistics of a world (M10). Set `struct_size` before the call.
@@ -938,6 +1028,12 @@ mpca_status mpca_world_add_emitter(struct mpca_world *world,
  * Changes the rate of emitter `index`.
  */
 mpca_status mpca_world_set_emitter_rate(struct mpca_world *world, uint32_t index, float rate);
+
+/**
+ * Gives the particles emitter `index` places from now on the tag `tag`,
+ * at most 255 (M6b); 0 until set. Needs a world with MPCA_IDENTITY_TAGS.
+ */
+mpca_status mpca_world_set_emitter_tag(struct mpca_world *world, uint32_t index, uint32_t tag);
 
 /**
  * Sets the uniform acceleration (3 values).
@@ -1133,6 +1229,12 @@ mpca_status mpca_world_remove_particle(struct mpca_world *world,
                                        struct mpca_particle *out);
 
 /**
+ * Gives the particle at `pos` the tag `tag`, at most 255 (M6b). Needs a
+ * world with MPCA_IDENTITY_TAGS.
+ */
+mpca_status mpca_world_set_tag(struct mpca_world *world, const uint32_t *pos, uint32_t tag);
+
+/**
  * What the cell at `pos` holds.
  */
 mpca_status mpca_world_cell(const struct mpca_world *world,
@@ -1179,6 +1281,22 @@ mpca_status mpca_world_export_masses(const struct mpca_world *world,
                                      float *out,
                                      size_t capacity,
                                      size_t *out_count);
+
+/**
+ * Writes every particle, in cell order (the order of every export), into
+ * the columns of `columns` that are not NULL, in one pass: entry `i` of
+ * each column is the same particle, so that an engine can match ids,
+ * ages and tags (M6b) to positions and velocities. `capacity` counts
+ * particles; the count goes to `out_count`, with the size query and the
+ * refusals of mpca_world_export_positions (every column NULL and
+ * `capacity` 0 asks for the count alone). A column of a plane the world
+ * does not keep is refused with MPCA_STATUS_NOT_ENABLED before anything
+ * is written.
+ */
+mpca_status mpca_world_export_particles(const struct mpca_world *world,
+                                        const struct mpca_particle_columns *columns,
+                                        size_t capacity,
+                                        size_t *out_count);
 
 /**
  * The share of occupied cells in each of `res` (3 values; the third 1 in

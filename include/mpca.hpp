@@ -346,6 +346,27 @@ public:
         return fill(&mpca_world_export_masses, out, capacity);
     }
 
+    /**
+     * Every particle, in cell order, into the non-null columns of
+     * `columns` (mpca_world_export_particles: positions, velocities, ids,
+     * ages, tags, each with room for `capacity` particles); sets its
+     * struct_size. Returns the particle count; the columns were filled
+     * only if that is not above `capacity`. All columns null with capacity
+     * 0 asks for the count alone.
+     */
+    std::size_t export_particles(mpca_particle_columns columns, std::size_t capacity) const {
+        columns.struct_size = sizeof columns;
+        std::size_t count = 0;
+        mpca_status s = mpca_world_export_particles(w_, &columns, capacity, &count);
+        if (s != MPCA_STATUS_OUTPUT_TOO_SMALL) {
+            check(s);
+        }
+        return count;
+    }
+
+    /** Gives the particle at `pos` the tag `tag` (mpca_world_set_tag). */
+    void set_tag(const cell_pos &pos, std::uint32_t tag) { check(mpca_world_set_tag(w_, pos.data(), tag)); }
+
     /** The share of occupied cells in each of res[0] x res[1] x res[2]
      * bins (res[2] is 1 in 2D), x fastest (mpca_world_density). */
     std::vector<float> density(const cell_pos &res) const {
@@ -488,6 +509,9 @@ public:
 
     /** Changes the rate of emitter `index`. */
     void set_emitter_rate(std::uint32_t index, float rate) { check(mpca_world_set_emitter_rate(w_, index, rate)); }
+
+    /** Gives the particles emitter `index` places the tag `tag`. */
+    void set_emitter_tag(std::uint32_t index, std::uint32_t tag) { check(mpca_world_set_emitter_tag(w_, index, tag)); }
 
 private:
     typedef mpca_status (*export_fn)(const mpca_world *, float *, std::size_t, std::size_t *);

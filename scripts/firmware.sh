@@ -15,7 +15,7 @@
 #   scripts/firmware.sh          the opt-level z build (what CI runs)
 #   scripts/firmware.sh --table  also opt-level s and 3 and an all-parts
 #                                library (dim3,obstacles,fields,mass,q16,
-#                                all-methods,collision-rules),
+#                                all-methods,collision-rules,identity),
 #                                and the host's instructions (callgrind)
 #
 # Boards: -M microbit (nRF51822, Cortex-M0, 16 KiB RAM) and -M mps2-an386
@@ -92,7 +92,7 @@ clz_from_libgcc() { case $1 in m0) echo ,--undefined=__clzsi2 ;; esac; }
 opt_level() { case $1 in all) echo z ;; *) echo "$1" ;; esac; }
 features() {
     case $1 in
-        all) echo dim3,obstacles,fields,mass,q16,all-methods,collision-rules ;;
+        all) echo dim3,obstacles,fields,mass,q16,all-methods,collision-rules,identity ;;
         *) echo vortex,small-step ;;
     esac
 }

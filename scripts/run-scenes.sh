@@ -2,8 +2,9 @@
 # The paper's four scenes, rendered: installs what is missing (Debian or
 # Ubuntu), builds libmpca and the C programs of c_examples/, runs the four
 # scenes at full size (and the smoke scene a second, longer time, and with
-# flow drag, M5.1b), and says where the images (PNG frames, contact sheets,
-# animated GIFs) are and how long the simulation took.
+# flow drag, M5.1b; and smoke-ids, smoke drawn between steps by id and
+# faded by age, M6b), and says where the images (PNG frames, contact
+# sheets, animated GIFs) are and how long the simulation took.
 #
 #   scripts/run-scenes.sh [--out DIR] [--docs]
 #
@@ -50,7 +51,7 @@ make -C c_examples --no-print-directory MPCA_LIB="$lib" BUILD="$bin" CC="$cc"
 echo "== the scenes, full size, images in $out"
 logs=$(mktemp -d)
 trap 'rm -rf "$logs"' EXIT
-runs=(aggregation cluster smoke water smoke-long smoke-flow water-pool)
+runs=(aggregation cluster smoke water smoke-long smoke-flow water-pool smoke-ids)
 # Images to be checked in are compressed harder: size matters there, the
 # time does not.
 png=()
@@ -132,7 +133,8 @@ if [ "$docs" -eq 1 ]; then
     section() { case "$1" in aggregation) echo "4.1 aggregation";; cluster) echo "4.2 cluster collision";;
         smoke) echo "4.3 smoke";; water) echo "4.4 water";; smoke-long) echo "4.3 smoke, longer run";;
         smoke-flow) echo "4.3 smoke with flow drag (M5.1b, beyond the paper)";;
-        water-pool) echo "4.4 water poured into a pool (M5.7 contacts, beyond the paper)";; esac; }
+        water-pool) echo "4.4 water poured into a pool (M5.7 contacts, beyond the paper)";;
+        smoke-ids) echo "smoke tracked by id, faded by age (M6b, beyond the paper)";; esac; }
     caption() { case "$1" in
         aggregation) echo "a gas at density 0.3 with e = 0.5 cools and gathers into clusters (slow, blue);";;
         cluster) echo "two discs meet at v = (±0.8, 0) and scatter, mostly across the line of flight;";;
@@ -140,6 +142,7 @@ if [ "$docs" -eq 1 ]; then
         water) echo "water poured on the sphere splashes off it and spreads over the floor;";;
         smoke-long) echo "the same smoke for 480 steps: the vortex bends the plume round its right side and flings it out at the top right;";;
         smoke-flow) echo "the smoke as buoyancy plus drag towards the air's flow, 1,200 steps. The air is a vortex fed through its core (the vortex's flow plus an inflow of the same profile, set per cell in the wind plane), so its streamlines spiral in: the plume rises at its terminal speed (slow colours, no clamp), winds up round the vortex's right side and over it into the core, and gathers there (22 % of the particles within 1.5 core radii at the end, against 1 % when the flow is the vortex's alone and the plume passes its side). Its density, in bins of 8 × 8 cells, is drawn as grey haze under the particles.";;
+        smoke-ids) echo "buoyant smoke in a breeze (the figures of docs/model.md, Units: buoyancy 0.0069, drag 0.033 towards a wind of 0.25 cells per step, a lifetime of 240 steps), periodic across, with ids and ages (M6b). After every step \`mpca_world_export_particles\` writes positions, ids and ages in one pass; the renderer sorts the particles by id and merges them with the last step's, and draws four frames a step, each particle sliding from its old cell to its new one (a new one appears where it is; one that wraps round the periodic edge jumps), as a soft puff that cools from yellow to violet and fades out with its age. The sheet is at whole steps; the GIF is the run's last frames, four a step (t=358.25 is a quarter of the way from step 358 to 359).";;
         water-pool) echo "a block of 9,216 particles released above the sphere under gravity 0.002, e = 0.5 and contacts on: it splashes off the sphere and, by step 1,000, lies as a pool on the floor (mean speed 0.07, no clamp), where the paper's rules (e = 1, no contacts) keep it bouncing round the box.";;
     esac; }
     # 12345 -> 12,345
@@ -171,7 +174,7 @@ if [ "$docs" -eq 1 ]; then
         echo "It installs what is missing (\`make\`, \`libosmesa6-dev\`, \`libpng-dev\`,"
         echo "\`libgif-dev\`, with \`apt-get\` as root or through \`sudo\`), builds \`libmpca\` in release"
         echo "mode and the programs with \`make\`, runs the four scenes at full size (and"
-        echo "the smoke scene a second time, for 480 steps, and with flow drag, and the water poured into a pool) and prints where the images"
+        echo "the smoke scene a second time, for 480 steps, and with flow drag, and the water poured into a pool; and smoke drawn between steps by id) and prints where the images"
         echo "are: \`out/scenes/\`. Each program also runs alone, e.g."
         echo "\`target/c_examples/water --size 32 --steps 200 --every 20 --out /tmp/w\`;"
         echo "\`--help\` lists its options (\`--size --steps --seed --every --tiles --px --out --name --threads --density --gif --png-level --progress --quiet --version\`);"

@@ -165,6 +165,13 @@ impl<'c> Call<'c> {
         Ok(unsafe { core::slice::from_raw_parts_mut(p, len) })
     }
 
+    /// [`Call::slice_mut`] where `p` is not NULL, `None` where it is: an
+    /// output the caller may leave out.
+    #[inline]
+    pub(crate) fn slice_mut_or_null<T: 'c>(&self, p: *mut T, len: usize, too_long: mpca_status) -> Result<Option<&'c mut [T]>, mpca_status> {
+        if p.is_null() { Ok(None) } else { self.slice_mut(p, len, too_long).map(Some) }
+    }
+
     /// Enters the world behind a handle for `access` until the call ends,
     /// and returns where it is: NULL, dead handles and a world busy with
     /// another call (hosted builds) are refused. An export enters one world.

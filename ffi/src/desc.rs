@@ -1,6 +1,6 @@
 //! `mpca_desc`: the scene description (M9), as C sees it.
 
-use mpca_core::{Boundary, Collisions, Description, Drag, Drift, Forces, Method, Quantization, Vortex};
+use mpca_core::{Boundary, Collisions, Description, Drag, Drift, Forces, Identity, Method, Quantization, Vortex};
 
 use crate::{check_size, guard, mpca_status};
 
@@ -63,6 +63,27 @@ pub enum mpca_force {
     /// The static Rankine vortex, `mpca_desc.vortex_*`.
     Vortex = 8,
 }
+
+/// Bits of `mpca_desc.identity` (M6b): the planes carried with every
+/// particle.
+#[repr(u32)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum mpca_identity {
+    /// A 32-bit id, unique in the world's life, from 1 (4 bytes a cell).
+    Ids = 1,
+    /// The steps each particle has taken part in (4 bytes a cell).
+    Ages = 2,
+    /// A byte of the caller's: mpca_world_set_tag, mpca_world_set_emitter_tag
+    /// (1 byte a cell).
+    Tags = 4,
+}
+
+// The C bits are the core's flags, which `to_core` takes as they are.
+const _: () = assert!(
+    mpca_identity::Ids as u32 == Identity::IDS.bits()
+        && mpca_identity::Ages as u32 == Identity::AGES.bits()
+        && mpca_identity::Tags as u32 == Identity::TAGS.bits()
+);
 
 /// A scene description. Fill it with mpca_desc_defaults, then change the
 /// fields the scene needs. Flags are 0 or 1.
@@ -139,10 +160,9 @@ pub struct mpca_desc {
     /// floats a cell, zero until mpca_world_set_wind_field or
     /// mpca_world_set_cell_wind sets it).
     pub drag_wind_field: u32,
-    /// 0: room a later version may give a meaning, so that the structure
-    /// has no padding (whole structures compare with memcmp). Anything
-    /// else is refused with MPCA_STATUS_BAD_ENUM.
-    pub reserved: u32,
+    /// `mpca_identity` bits: ids, ages and tags carried with the particles
+    /// (M6b); 0, none, by default.
+    pub identity: u32,
 }
 
 /// Description::new_2d's defaults as C sees them (the sizes aside), built
@@ -221,12 +241,14 @@ impl mpca_desc {
             drag_wind: d.drag.wind,
             drag_vortex: d.drag.vortex as u32,
             drag_wind_field: d.drag.field as u32,
-            reserved: 0,
+            identity: 0,
         }
     }
 
     /// The core description; unknown enum values and flags are refused
-    /// here, everything else by the core's own validation.
+    /// here, everything else by the core's own validation. Out of line:
+    /// every export that takes a description calls it.
+    #[inline(never)]
     pub(crate) fn to_core(self) -> Result<Description, mpca_status> {
         check_size::<mpca_desc>(self.struct_size)?;
         // Every field is set below: the constant only gives the
@@ -239,9 +261,12 @@ impl mpca_desc {
         // small core). `d` is a local: what a refusal leaves in it is
         // dropped.
         let mut ones = 0;
+        // The flag is the value's low bit: a value above 1 is refused
+        // below whatever it converted to, and the bit alone is a masking
+        // and a store where `v != 0` takes a comparison and a select each.
         let mut one = |v: u32| {
             ones |= v;
-            v != 0
+            v & 1 != 0
         };
         d.per_particle_mass = one(self.per_particle_mass);
         d.obstacles = one(self.obstacles);
@@ -251,9 +276,11 @@ impl mpca_desc {
         d.energy_neutral = one(self.energy_neutral);
         d.drag = Drag { rate: self.drag_rate, wind: self.drag_wind, field: one(self.drag_wind_field), vortex: one(self.drag_vortex) };
         d.lifetimes = one(self.lifetimes);
-        if ones > 1 || self.forces & !FORCE_BITS != 0 || self.reserved != 0 {
+        if ones > 1 || self.forces & !FORCE_BITS != 0 || self.identity > Identity::ALL.bits() {
             return Err(mpca_status::BadEnum);
         }
+        // The core's flags are the C ABI's bits (checked at the top).
+        d.identity = Identity::from_bits(self.identity).unwrap_or_default();
         d.dim = self.dim;
         d.seed = self.seed;
         d.size = self.size;

@@ -59,3 +59,14 @@ pub unsafe extern "C" fn mpca_world_set_emitter_rate(world: *mut mpca_world, ind
         Ok(w.set_emitter_rate(index as usize, rate)?)
     })
 }
+
+/// Gives the particles emitter `index` places from now on the tag `tag`,
+/// at most 255 (M6b); 0 until set. Needs a world with MPCA_IDENTITY_TAGS.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mpca_world_set_emitter_tag(world: *mut mpca_world, index: u32, tag: u32) -> mpca_status {
+    guard(|c| {
+        let w = c.world(world)?;
+        let tag = u8::try_from(tag).map_err(|_| mpca_status::TagRange)?;
+        Ok(w.set_emitter_tag(index as usize, tag)?)
+    })
+}

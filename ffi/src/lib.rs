@@ -102,9 +102,10 @@ const _: () = {
     assert!(size_of::<mpca_desc>() == 176 && align_of::<mpca_desc>() == 8);
     assert!(size_of::<mpca_stats>() == 144 && align_of::<mpca_stats>() == 8);
     assert!(size_of::<mpca_region_stats>() == 48 && align_of::<mpca_region_stats>() == 8);
-    assert!(size_of::<mpca_particle>() == 32 && align_of::<mpca_particle>() == 4);
-    assert!(size_of::<mpca_cell>() == 36 && align_of::<mpca_cell>() == 4);
+    assert!(size_of::<mpca_particle>() == 44 && align_of::<mpca_particle>() == 4);
+    assert!(size_of::<mpca_cell>() == 48 && align_of::<mpca_cell>() == 4);
     assert!(size_of::<mpca_emitter>() == 56 && align_of::<mpca_emitter>() == 4);
+    assert!(size_of::<mpca_particle_columns>() == 8 + 5 * size_of::<*mut f32>() && align_of::<mpca_particle_columns>() == align_of::<*mut f32>());
     assert!(size_of::<mpca_status>() == 4 && size_of::<mpca_boundary>() == 4);
 };
 

@@ -3,7 +3,8 @@
 
 use mpca_core::{Cell, Particle};
 
-use crate::{guard, mpca_status, mpca_world, Call};
+use crate::snapshot::overlap;
+use crate::{check_size, guard, mpca_status, mpca_world, Call};
 
 /// One particle.
 #[repr(C)]
@@ -17,6 +18,13 @@ pub struct mpca_particle {
     pub mass: f32,
     /// Steps left to live, 0 for no limit.
     pub life: u32,
+    /// Its id, unique in the world's life, from 1 (M6b); 0 in a world
+    /// without MPCA_IDENTITY_IDS.
+    pub id: u32,
+    /// The steps it has taken part in; 0 without MPCA_IDENTITY_AGES.
+    pub age: u32,
+    /// The caller's tag, 0 to 255; 0 without MPCA_IDENTITY_TAGS.
+    pub tag: u32,
 }
 
 /// What a cell holds. Values of `mpca_cell.kind`.
@@ -42,7 +50,7 @@ pub struct mpca_cell {
 }
 
 fn particle_to_c(p: Particle) -> mpca_particle {
-    mpca_particle { pos: p.pos, velocity: p.velocity, mass: p.mass, life: u32::from(p.life) }
+    mpca_particle { pos: p.pos, velocity: p.velocity, mass: p.mass, life: u32::from(p.life), id: p.id, age: p.age, tag: u32::from(p.tag) }
 }
 
 /// Adds a particle of the world's mass at `pos` (3 values) with velocity
@@ -87,6 +95,18 @@ pub unsafe extern "C" fn mpca_world_remove_particle(world: *mut mpca_world, pos:
         let out = c.out(out)?;
         out.set(particle_to_c(w.remove_particle(pos)?));
         Ok(())
+    })
+}
+
+/// Gives the particle at `pos` the tag `tag`, at most 255 (M6b). Needs a
+/// world with MPCA_IDENTITY_TAGS.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mpca_world_set_tag(world: *mut mpca_world, pos: *const u32, tag: u32) -> mpca_status {
+    guard(|c| {
+        let w = c.world(world)?;
+        let pos = c.array(pos)?;
+        let tag = u8::try_from(tag).map_err(|_| mpca_status::TagRange)?;
+        Ok(w.set_tag(pos, tag)?)
     })
 }
 
@@ -195,6 +215,111 @@ pub unsafe extern "C" fn mpca_world_export_masses(
     out_count: *mut usize,
 ) -> mpca_status {
     guard(|c| export(c, world, out, capacity, out_count, 1, |p, o| o[0] = p.mass))
+}
+
+/// Where mpca_world_export_particles writes, a column per quantity: each
+/// NULL or an array with room for `capacity` particles. Set `struct_size`
+/// to `sizeof(mpca_particle_columns)`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct mpca_particle_columns {
+    /// `sizeof(mpca_particle_columns)`.
+    pub struct_size: u32,
+    /// 0: room a later version may give a meaning (no padding before the
+    /// pointers). Anything else is refused with MPCA_STATUS_BAD_ENUM.
+    pub reserved: u32,
+    /// 3 floats a particle: the cell's centre, as
+    /// mpca_world_export_positions writes.
+    pub positions: *mut f32,
+    /// 3 floats a particle: the velocity in cells per step.
+    pub velocities: *mut f32,
+    /// One a particle: its id (needs MPCA_IDENTITY_IDS).
+    pub ids: *mut u32,
+    /// One a particle: its age in steps (needs MPCA_IDENTITY_AGES).
+    pub ages: *mut u32,
+    /// One a particle: its tag (needs MPCA_IDENTITY_TAGS).
+    pub tags: *mut u8,
+}
+
+/// Writes every particle, in cell order (the order of every export), into
+/// the columns of `columns` that are not NULL, in one pass: entry `i` of
+/// each column is the same particle, so that an engine can match ids,
+/// ages and tags (M6b) to positions and velocities. `capacity` counts
+/// particles; the count goes to `out_count`, with the size query and the
+/// refusals of mpca_world_export_positions (every column NULL and
+/// `capacity` 0 asks for the count alone). A column of a plane the world
+/// does not keep is refused with MPCA_STATUS_NOT_ENABLED before anything
+/// is written.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mpca_world_export_particles(
+    world: *const mpca_world,
+    columns: *const mpca_particle_columns,
+    capacity: usize,
+    out_count: *mut usize,
+) -> mpca_status {
+    guard(|c| {
+        let w = c.world_ref(world)?;
+        let cols = c.get(columns)?;
+        check_size::<mpca_particle_columns>(cols.struct_size)?;
+        if cols.reserved != 0 {
+            return Err(mpca_status::BadEnum);
+        }
+        let on = w.description().identity;
+        let missing = |column_set: bool, kept: bool| column_set && !kept;
+        if missing(!cols.ids.is_null(), on.ids()) || missing(!cols.ages.is_null(), on.ages()) || missing(!cols.tags.is_null(), on.tags()) {
+            return Err(mpca_core::Error::NotEnabled.into());
+        }
+        let count = c.out(out_count)?;
+        let none = cols.positions.is_null() && cols.velocities.is_null() && cols.ids.is_null() && cols.ages.is_null() && cols.tags.is_null();
+        let n = w.particle_count() as usize;
+        count.set(n);
+        if none {
+            // The size query; room claimed for no column is a NULL column.
+            return if capacity == 0 { Ok(()) } else { Err(mpca_status::NullPointer) };
+        }
+        if capacity < n {
+            return Err(mpca_status::OutputTooSmall);
+        }
+        let too_small = mpca_status::OutputTooSmall;
+        let triples = n.checked_mul(3).ok_or(too_small)?;
+        // Each column is its own array: two that share a byte are refused
+        // before a slice is formed over either.
+        let spans = [
+            (cols.positions.cast::<u8>(), triples.saturating_mul(4)),
+            (cols.velocities.cast::<u8>(), triples.saturating_mul(4)),
+            (cols.ids.cast::<u8>(), n.saturating_mul(4)),
+            (cols.ages.cast::<u8>(), n.saturating_mul(4)),
+            (cols.tags, n),
+        ];
+        for (i, &(a, a_len)) in spans.iter().enumerate() {
+            if spans[i + 1..].iter().any(|&(b, b_len)| overlap(a, a_len, b, b_len)) {
+                return Err(mpca_status::Overlap);
+            }
+        }
+        let mut positions = c.slice_mut_or_null(cols.positions, triples, too_small)?;
+        let mut velocities = c.slice_mut_or_null(cols.velocities, triples, too_small)?;
+        let mut ids = c.slice_mut_or_null(cols.ids, n, too_small)?;
+        let mut ages = c.slice_mut_or_null(cols.ages, n, too_small)?;
+        let mut tags = c.slice_mut_or_null(cols.tags, n, too_small)?;
+        for (i, p) in w.particles().enumerate() {
+            if let Some(out) = positions.as_deref_mut() {
+                out[3 * i..3 * i + 3].copy_from_slice(&p.pos.map(|x| x as f32 + 0.5));
+            }
+            if let Some(out) = velocities.as_deref_mut() {
+                out[3 * i..3 * i + 3].copy_from_slice(&p.velocity);
+            }
+            if let Some(out) = ids.as_deref_mut() {
+                out[i] = p.id;
+            }
+            if let Some(out) = ages.as_deref_mut() {
+                out[i] = p.age;
+            }
+            if let Some(out) = tags.as_deref_mut() {
+                out[i] = p.tag;
+            }
+        }
+        Ok(())
+    })
 }
 
 /// The share of occupied cells in each of `res` (3 values; the third 1 in

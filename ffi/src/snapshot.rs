@@ -11,7 +11,9 @@ use crate::{fits, guard, handle, mpca_desc, mpca_status, mpca_world};
 /// Whether `a_len` bytes at `a` and `b_len` bytes at `b` share a byte;
 /// found from the addresses alone, before any slice is formed over either.
 /// NULL and lengths no object can have are left to `Call::slice` to refuse.
-fn overlap(a: *const u8, a_len: usize, b: *const u8, b_len: usize) -> bool {
+/// Out of line: the export of particles asks it of every pair of columns.
+#[inline(never)]
+pub(crate) fn overlap(a: *const u8, a_len: usize, b: *const u8, b_len: usize) -> bool {
     if a.is_null() || b.is_null() || !fits::<u8>(a_len) || !fits::<u8>(b_len) {
         return false;
     }

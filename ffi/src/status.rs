@@ -48,6 +48,8 @@ pub enum mpca_status {
     /// handed to mpca_world_init or mpca_world_init_from_image and a world
     /// mpca_world_create allocated (hosted builds).
     Overlap = 12,
+    /// A tag is above 255: tags are one byte (M6b).
+    TagRange = 13,
     /// The dimension is neither 2 nor 3.
     BadDimension = 100,
     /// 3D worlds are not built into this library.
@@ -132,6 +134,9 @@ pub enum mpca_status {
     ImageMismatch = 138,
     /// A flow drag rate is negative (M5.1b).
     BadDrag = 140,
+    /// Every particle id of the world's life was given: no particle can be
+    /// added, and emitters count what they ask for as shortfall (M6b).
+    IdsExhausted = 141,
     /// An error this version of the C ABI does not know by name.
     Unknown = 199,
 }
@@ -219,10 +224,11 @@ impl mpca_status {
             S::StaleTask => c"the ticket is not the parallel step in flight on this world",
             S::TaskIndex => c"the task index is not below the step's task count",
             S::TaskDone => c"this task of the step was run already",
+            S::TagRange => c"a tag is above 255",
             S::Overlap => c"an image overlaps the memory of its world, or new world memory lies in a world the library allocated",
             S::Unknown => c"an error this version of the C ABI does not name",
             // The statuses of core errors say what core says.
-            S::BadHandle | S::OutputTooSmall | S::BadDimension | S::Dim3Disabled | S::SizeZero | S::SizeOdd | S::TooLarge | S::PeriodicMismatch | S::NotFinite | S::NegativeDt | S::BadVortex | S::BadDrag | S::RestitutionRange | S::MassRange | S::SpeedRange | S::Q16Disabled | S::FeatureDisabled | S::NotEnabled | S::CapacityRange | S::BufferTooSmall | S::OutOfBounds | S::CellOccupied | S::CellObstacle | S::NoParticle | S::MassTableFull | S::SurfaceTableFull | S::UndefinedNormal | S::EmitterTableFull | S::BadEmitter | S::LifetimeRange | S::BadShape | S::BadResolution | S::BadLength | S::NotOwned | S::OutOfMemory | S::NotAnImage | S::ImageVersion | S::ImageLength | S::ImageChecksum | S::ImageInvalid | S::ImageMismatch => match self.core_error() {
+            S::BadHandle | S::OutputTooSmall | S::BadDimension | S::Dim3Disabled | S::SizeZero | S::SizeOdd | S::TooLarge | S::PeriodicMismatch | S::NotFinite | S::NegativeDt | S::BadVortex | S::BadDrag | S::RestitutionRange | S::MassRange | S::SpeedRange | S::Q16Disabled | S::FeatureDisabled | S::NotEnabled | S::CapacityRange | S::BufferTooSmall | S::OutOfBounds | S::CellOccupied | S::CellObstacle | S::NoParticle | S::MassTableFull | S::SurfaceTableFull | S::UndefinedNormal | S::EmitterTableFull | S::BadEmitter | S::LifetimeRange | S::BadShape | S::BadResolution | S::BadLength | S::NotOwned | S::OutOfMemory | S::NotAnImage | S::ImageVersion | S::ImageLength | S::ImageChecksum | S::ImageInvalid | S::ImageMismatch | S::IdsExhausted => match self.core_error() {
                 Some(e) => e.c_message(),
                 None => panic!("a status listed as a core error's has no core error"),
             },
@@ -241,18 +247,19 @@ pub extern "C" fn mpca_status_message(status: u32) -> *const c_char {
 }
 
 /// Every status, for looking one up by number.
-const ALL: [mpca_status; 53] = {
+const ALL: [mpca_status; 55] = {
     use mpca_status as S;
     [
         S::Ok, S::NullPointer, S::BadHandle, S::Panic, S::BadStructSize, S::BadEnum, S::OutputTooSmall, S::NotASurface,
-        S::Busy, S::StaleTask, S::TaskIndex, S::TaskDone, S::Overlap,
+        S::Busy, S::StaleTask, S::TaskIndex, S::TaskDone, S::Overlap, S::TagRange,
         S::BadDimension, S::Dim3Disabled, S::SizeZero, S::SizeOdd, S::TooLarge, S::PeriodicMismatch,
         S::NotFinite, S::NegativeDt, S::BadVortex, S::BadDrag, S::RestitutionRange, S::MassRange, S::SpeedRange,
         S::Q16Disabled, S::FeatureDisabled, S::NotEnabled, S::CapacityRange, S::BufferTooSmall,
         S::OutOfBounds, S::CellOccupied, S::CellObstacle, S::NoParticle, S::MassTableFull,
         S::SurfaceTableFull, S::UndefinedNormal, S::EmitterTableFull, S::BadEmitter, S::LifetimeRange,
         S::BadShape, S::BadResolution, S::BadLength, S::NotOwned, S::OutOfMemory,
-        S::NotAnImage, S::ImageVersion, S::ImageLength, S::ImageChecksum, S::ImageInvalid, S::ImageMismatch, S::Unknown,
+        S::NotAnImage, S::ImageVersion, S::ImageLength, S::ImageChecksum, S::ImageInvalid, S::ImageMismatch, S::IdsExhausted,
+        S::Unknown,
     ]
 };
 

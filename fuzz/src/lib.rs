@@ -185,7 +185,7 @@ fn desc_words(d: &mut mpca_desc, each: &mut dyn FnMut(&mut u32)) {
     }
     each(&mut d.drag_vortex);
     each(&mut d.drag_wind_field);
-    each(&mut d.reserved);
+    each(&mut d.identity);
 }
 
 /// An `mpca_desc` from the input, every field any value.

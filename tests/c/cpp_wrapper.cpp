@@ -233,6 +233,21 @@ static void same_as_c() {
     CHECK(w.export_velocities(buffer.data(), n - 1) == n);
     CHECK(buffer == std::vector<float>(3 * n, -7.0f));
     CHECK(w.export_velocities(buffer.data(), n) == n && buffer == vel_c);
+    {
+        /* One pass, the same order: the columns are the twins' exports. */
+        std::vector<float> pos_all(3 * n), vel_all(3 * n);
+        mpca_particle_columns columns = mpca_particle_columns();
+        CHECK(w.export_particles(columns, 0) == n); /* the size query */
+        columns.positions = pos_all.data();
+        columns.velocities = vel_all.data();
+        CHECK(w.export_particles(columns, n - 1) == n);
+        CHECK(w.export_particles(columns, n) == n && pos_all == pos_c && vel_all == vel_c);
+        std::vector<std::uint32_t> ids(n);
+        columns.ids = ids.data();
+        THROWS(MPCA_STATUS_NOT_ENABLED, w.export_particles(columns, n)); /* a world without ids */
+        THROWS(MPCA_STATUS_NOT_ENABLED, w.set_tag(mpca::cell_pos{{0, 0, 0}}, 1u));
+        THROWS(MPCA_STATUS_NOT_ENABLED, w.set_emitter_tag(0, 1));
+    }
 
     /* Density at the world's resolution is the occupancy. */
     std::vector<float> occupancy = w.density({32, 32, 1});
@@ -547,6 +562,9 @@ static void every_function() {
     WRAPS(mpca_world_export_positions, &W::export_positions);
     WRAPS(mpca_world_export_velocities, &W::export_velocities);
     WRAPS(mpca_world_export_masses, &W::export_masses);
+    WRAPS(mpca_world_export_particles, &W::export_particles);
+    WRAPS(mpca_world_set_tag, &W::set_tag);
+    WRAPS(mpca_world_set_emitter_tag, &W::set_emitter_tag);
     WRAPS(mpca_world_density, &W::density);
     WRAPS(mpca_world_density_u8, &W::density_u8);
     WRAPS(mpca_world_region_stats, &W::region_stats);

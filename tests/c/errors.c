@@ -21,8 +21,9 @@
 /* The layout ffi/src/lib.rs asserts on the Rust side. */
 STATIC_ASSERT(sizeof(mpca_desc) == 176 && ALIGNOF(mpca_desc) == 8, "mpca_desc layout");
 STATIC_ASSERT(sizeof(mpca_stats) == 144 && ALIGNOF(mpca_stats) == 8, "mpca_stats layout");
-STATIC_ASSERT(sizeof(mpca_particle) == 32 && ALIGNOF(mpca_particle) == 4, "mpca_particle layout");
-STATIC_ASSERT(sizeof(mpca_cell) == 36 && ALIGNOF(mpca_cell) == 4, "mpca_cell layout");
+STATIC_ASSERT(sizeof(mpca_particle) == 44 && ALIGNOF(mpca_particle) == 4, "mpca_particle layout");
+STATIC_ASSERT(sizeof(mpca_particle_columns) == 8 + 5 * sizeof(void *) && ALIGNOF(mpca_particle_columns) == ALIGNOF(void *), "mpca_particle_columns layout");
+STATIC_ASSERT(sizeof(mpca_cell) == 48 && ALIGNOF(mpca_cell) == 4, "mpca_cell layout");
 STATIC_ASSERT(sizeof(mpca_emitter) == 56 && ALIGNOF(mpca_emitter) == 4, "mpca_emitter layout");
 STATIC_ASSERT(sizeof(mpca_status) == 4 && sizeof(mpca_boundary) == 4, "enum sizes");
 
@@ -173,6 +174,7 @@ static mpca_desc full_desc(uint32_t dim, uint32_t n) {
     d.emitter_capacity = 2;
     d.drag_rate = 0.1f;
     d.drag_wind_field = 1;
+    d.identity = MPCA_IDENTITY_IDS | MPCA_IDENTITY_AGES | MPCA_IDENTITY_TAGS;
     return d;
 }
 
@@ -243,6 +245,8 @@ static void build_worlds(void) {
     CHECK_OK(mpca_world_add_emitter(full2, &e, &index)); /* one of two slots used */
     CHECK(index == 0);
     CHECK_OK(mpca_world_set_emitter_rate(full2, 0, 0.75f));
+    CHECK_OK(mpca_world_set_emitter_tag(full2, 0, 200));
+    CHECK_OK(mpca_world_set_tag(full2, p2, 255));
     for (unsigned i = 0; i < CELLS2; i++) {
         field2[2 * i] = 0.001f * (float)(i % 7);
         field2[2 * i + 1] = -0.002f;
@@ -390,7 +394,7 @@ static void description_cases(void) {
         DESC_VALUES(base, energy_neutral, MPCA_STATUS_BAD_ENUM, 2, UINT32_MAX);
         DESC_VALUES(base, drag_vortex, MPCA_STATUS_BAD_ENUM, 2, UINT32_MAX);
         DESC_VALUES(base, drag_wind_field, MPCA_STATUS_BAD_ENUM, 2, UINT32_MAX);
-        DESC_VALUES(base, reserved, MPCA_STATUS_BAD_ENUM, 1, UINT32_MAX);
+        DESC_VALUES(base, identity, MPCA_STATUS_BAD_ENUM, 8, UINT32_MAX);
         DESC_VALUES(base, mass_classes, MPCA_STATUS_CAPACITY_RANGE, 0, 257, UINT32_MAX);
 
         /* Every float field, the third gravity component in 2D included. */
@@ -560,6 +564,13 @@ static void handle_sweep(mpca_world *h, mpca_status want, const char *kind) {
     REFUSED(want, mpca_world_export_positions(h, out, CELLS2, &count));
     REFUSED(want, mpca_world_export_velocities(h, out, CELLS2, &count));
     REFUSED(want, mpca_world_export_masses(h, out, CELLS2, &count));
+    mpca_particle_columns cols;
+    memset(&cols, 0, sizeof cols);
+    cols.struct_size = sizeof cols;
+    cols.positions = out;
+    REFUSED(want, mpca_world_export_particles(h, &cols, CELLS2, &count));
+    REFUSED(want, mpca_world_set_tag(h, pos, 1));
+    REFUSED(want, mpca_world_set_emitter_tag(h, 0, 1));
     REFUSED(want, mpca_world_density(h, res, out, 4));
     REFUSED(want, mpca_world_density_u8(h, res, bytes, 4));
     REFUSED(want, mpca_world_step(h, 1));
@@ -714,6 +725,13 @@ static void null_cases(void) {
     REFUSED(MPCA_STATUS_NULL_POINTER, mpca_world_export_velocities(w, out, CELLS2, NULL));
     REFUSED(MPCA_STATUS_NULL_POINTER, mpca_world_export_masses(w, NULL, CELLS2, &count));
     REFUSED(MPCA_STATUS_NULL_POINTER, mpca_world_export_masses(w, out, CELLS2, NULL));
+    mpca_particle_columns cols;
+    memset(&cols, 0, sizeof cols);
+    cols.struct_size = sizeof cols;
+    cols.positions = out;
+    REFUSED(MPCA_STATUS_NULL_POINTER, mpca_world_export_particles(w, NULL, CELLS2, &count));
+    REFUSED(MPCA_STATUS_NULL_POINTER, mpca_world_export_particles(w, &cols, CELLS2, NULL));
+    REFUSED(MPCA_STATUS_NULL_POINTER, mpca_world_set_tag(w, NULL, 1));
     REFUSED(MPCA_STATUS_NULL_POINTER, mpca_world_density(w, NULL, out, 4));
     REFUSED(MPCA_STATUS_NULL_POINTER, mpca_world_density(w, res, NULL, 4));
     REFUSED(MPCA_STATUS_NULL_POINTER, mpca_world_density_u8(w, NULL, bytes, 4));
@@ -1225,6 +1243,7 @@ static const struct {
     STATUS(MPCA_STATUS_TASK_INDEX),
     STATUS(MPCA_STATUS_TASK_DONE),
     STATUS(MPCA_STATUS_OVERLAP),
+    STATUS(MPCA_STATUS_TAG_RANGE),
     STATUS(MPCA_STATUS_BAD_DIMENSION),
     STATUS(MPCA_STATUS_DIM3_DISABLED),
     STATUS(MPCA_STATUS_SIZE_ZERO),
@@ -1264,6 +1283,7 @@ static const struct {
     STATUS(MPCA_STATUS_IMAGE_CHECKSUM),
     STATUS(MPCA_STATUS_IMAGE_INVALID),
     STATUS(MPCA_STATUS_IMAGE_MISMATCH),
+    STATUS(MPCA_STATUS_IDS_EXHAUSTED),
     STATUS(MPCA_STATUS_UNKNOWN),
 };
 #define STATUS_COUNT (sizeof STATUSES / sizeof STATUSES[0])
@@ -1271,6 +1291,106 @@ static const struct {
 /* Every status has its own non-empty message; numbers that are no status
  * share one message, different from all of those. Prints "status: NAME N"
  * so the Rust side can compare the table with the header. */
+/* --- Identity (M6b): tags and the one-pass export ---------------------- */
+
+static void identity_cases(void) {
+    uint32_t particle[3] = {4, 8, 0}, empty[3] = {1, 12, 0}, outside[3] = {N2, 0, 0};
+    set_context("mpca_world_set_tag");
+    REFUSED(MPCA_STATUS_TAG_RANGE, mpca_world_set_tag(full2, particle, 256));
+    REFUSED(MPCA_STATUS_TAG_RANGE, mpca_world_set_tag(full2, particle, UINT32_MAX));
+    REFUSED(MPCA_STATUS_NO_PARTICLE, mpca_world_set_tag(full2, empty, 1));
+    REFUSED(MPCA_STATUS_OUT_OF_BOUNDS, mpca_world_set_tag(full2, outside, 1));
+    uint32_t bare_particle[3] = {1, 1, 0};
+    REFUSED(MPCA_STATUS_NOT_ENABLED, mpca_world_set_tag(bare2, bare_particle, 1));
+    set_context("mpca_world_set_emitter_tag");
+    REFUSED(MPCA_STATUS_TAG_RANGE, mpca_world_set_emitter_tag(full2, 0, 256));
+    REFUSED(MPCA_STATUS_OUT_OF_BOUNDS, mpca_world_set_emitter_tag(full2, 2, 1)); /* room for two */
+    REFUSED(MPCA_STATUS_OUT_OF_BOUNDS, mpca_world_set_emitter_tag(full2, UINT32_MAX, 1));
+    REFUSED(MPCA_STATUS_NOT_ENABLED, mpca_world_set_emitter_tag(bare2, 0, 1));
+
+    set_context("mpca_world_export_particles");
+    size_t n = 0;
+    CHECK_OK(mpca_world_particle_count(full2, &n));
+    static float positions[CELLS2 * 3], velocities[CELLS2 * 3];
+    static uint32_t ids[CELLS2], ages[CELLS2];
+    static uint8_t tags[CELLS2];
+    for (size_t i = 0; i < CELLS2 * 3; i++) {
+        positions[i] = velocities[i] = SENTINEL_FLOAT;
+    }
+    memset(ids, SENTINEL_BYTE, sizeof ids);
+    mpca_particle_columns cols;
+    memset(&cols, 0, sizeof cols);
+    cols.struct_size = sizeof cols;
+    cols.positions = positions;
+    cols.velocities = velocities;
+    cols.ids = ids;
+    cols.ages = ages;
+    cols.tags = tags;
+    size_t count = SENTINEL_SIZE;
+    cols.struct_size = sizeof cols - 1;
+    REFUSED(MPCA_STATUS_BAD_STRUCT_SIZE, mpca_world_export_particles(full2, &cols, CELLS2, &count));
+    cols.struct_size = sizeof cols;
+    cols.reserved = 1;
+    REFUSED(MPCA_STATUS_BAD_ENUM, mpca_world_export_particles(full2, &cols, CELLS2, &count));
+    cols.reserved = 0;
+    CHECK(count == SENTINEL_SIZE);
+    /* A column of a plane the world does not keep. */
+    REFUSED(MPCA_STATUS_NOT_ENABLED, mpca_world_export_particles(bare2, &cols, CELLS2, &count));
+    CHECK(count == SENTINEL_SIZE);
+    /* Too small: the count, nothing written. */
+    REFUSED(MPCA_STATUS_OUTPUT_TOO_SMALL, mpca_world_export_particles(full2, &cols, n - 1, &count));
+    CHECK(count == n);
+    /* Columns that share memory. */
+    count = SENTINEL_SIZE;
+    cols.velocities = positions + 3;
+    REFUSED(MPCA_STATUS_OVERLAP, mpca_world_export_particles(full2, &cols, CELLS2, &count));
+    cols.velocities = velocities;
+    cols.ages = ids;
+    REFUSED(MPCA_STATUS_OVERLAP, mpca_world_export_particles(full2, &cols, CELLS2, &count));
+    cols.ages = ages;
+    cols.tags = (uint8_t *)(void *)(ids + n - 1);
+    REFUSED(MPCA_STATUS_OVERLAP, mpca_world_export_particles(full2, &cols, CELLS2, &count));
+    cols.tags = tags;
+    size_t written = 0;
+    for (size_t i = 0; i < CELLS2 * 3; i++) {
+        written += positions[i] != SENTINEL_FLOAT || velocities[i] != SENTINEL_FLOAT;
+    }
+    CHECK(written == 0);
+    CHECK(ids[0] == 0xa5a5a5a5u);
+    /* No column: the size query with capacity 0, else a NULL column. */
+    mpca_particle_columns none;
+    memset(&none, 0, sizeof none);
+    none.struct_size = sizeof none;
+    count = SENTINEL_SIZE;
+    CHECK_OK(mpca_world_export_particles(full2, &none, 0, &count));
+    CHECK(count == n);
+    count = SENTINEL_SIZE;
+    REFUSED(MPCA_STATUS_NULL_POINTER, mpca_world_export_particles(full2, &none, n, &count));
+
+    /* The export itself: the twins' positions and velocities, the cells'
+     * ids, ages and tags, in one order; ids positive and distinct. */
+    CHECK_OK(mpca_world_export_particles(full2, &cols, CELLS2, &count));
+    CHECK(count == n);
+    static float twin[CELLS2 * 3];
+    CHECK_OK(mpca_world_export_positions(full2, twin, CELLS2, &count));
+    CHECK(memcmp(twin, positions, n * 3 * sizeof(float)) == 0);
+    CHECK_OK(mpca_world_export_velocities(full2, twin, CELLS2, &count));
+    CHECK(memcmp(twin, velocities, n * 3 * sizeof(float)) == 0);
+    unsigned tagged = 0;
+    for (size_t i = 0; i < n; i++) {
+        uint32_t pos[3] = {(uint32_t)positions[3 * i], (uint32_t)positions[3 * i + 1], 0};
+        mpca_cell c;
+        CHECK_OK(mpca_world_cell(full2, pos, &c));
+        CHECK(c.kind == MPCA_CELL_KIND_PARTICLE && c.particle.id == ids[i] && c.particle.age == ages[i] && c.particle.tag == tags[i]);
+        CHECK(ids[i] > 0);
+        for (size_t j = 0; j < i; j++) {
+            CHECK(ids[j] != ids[i]);
+        }
+        tagged += tags[i] == 255;
+    }
+    CHECK(tagged == 1); /* set_tag in build_worlds */
+}
+
 static void message_cases(void) {
     set_context("status messages");
     const char *messages[STATUS_COUNT];
@@ -1282,7 +1402,7 @@ static void message_cases(void) {
             CHECK(messages[j] == NULL || strcmp(messages[i], messages[j]) != 0);
         }
     }
-    const uint32_t unknown[] = {13, 99, 130, 139, 198, 200, 1000, 0x7fffffffu, UINT32_MAX};
+    const uint32_t unknown[] = {14, 99, 130, 139, 142, 198, 200, 1000, 0x7fffffffu, UINT32_MAX};
     const char *first = TRACE(mpca_status_message(unknown[0]));
     CHECK(first != NULL && first[0] != '\0');
     for (unsigned i = 0; i < sizeof unknown / sizeof unknown[0] && first != NULL; i++) {
@@ -1345,6 +1465,7 @@ int main(void) {
     obstacle_cases();
     particle_cases();
     output_cases();
+    identity_cases();
     handle_cases();
     message_cases();
     success_cases();

@@ -338,7 +338,14 @@ fn unit(rng: &mut Pcg32) -> f32 {
 /// calibrated drift rule, every boundary kind and the given method: every
 /// optional part at once, for the hash checks across targets and commits.
 pub fn every_part(memory: &mut Vec<u8>, method: Method) -> &mut World {
+    every_part_with(memory, method, mpca::Identity::NONE)
+}
+
+/// [`every_part`] with the identity planes `identity` (M6b), which change
+/// nothing else of the world.
+pub fn every_part_with(memory: &mut Vec<u8>, method: Method, identity: mpca::Identity) -> &mut World {
     let mut d = Description::new_3d(16, 16, 16);
+    d.identity = identity;
     d.boundary = [[Boundary::Periodic; 2], [Boundary::Wall, Boundary::Open], [Boundary::Open, Boundary::Wall]];
     d.per_particle_mass = true;
     d.mass_classes = 4;

@@ -354,6 +354,62 @@ fn water_small_run_draws_the_sphere_the_box_and_the_water() {
     check_small_run("water", 32, 40, 10, Fixed::AtStepZero(0.5));
 }
 
+/// `smoke-ids` (M6b): smoke drawn between steps by following each
+/// particle's id and faded by its age. The program checks M6b's promises
+/// itself as it tracks the particles (ids unique and never 0, new ids above
+/// the old, one step older when seen again, at most a cell away or wrapped
+/// round the periodic edge) and exits 1 when one fails; here it must run
+/// through, follow particles from step to step, see some wrap, and write
+/// its frames, its sheet, and a GIF of four frames a step whose last is the
+/// end of the run.
+#[test]
+fn smoke_ids_follows_every_particle_by_id_and_draws_between_steps() {
+    let out_dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("examples").join("smoke-ids");
+    let _ = std::fs::remove_dir_all(&out_dir);
+    let out_s = out_dir.to_string_lossy().into_owned();
+    let stdout = run(
+        "smoke-ids",
+        &["--size", "32", "--steps", "200", "--every", "100", "--tiles", "3", "--gif", "10", "--px", "256", "--out", &out_s],
+    );
+    println!("{stdout}");
+    let ids_line = stdout.lines().find(|l| l.starts_with("ids: ")).expect("an ids: line");
+    let ids = fields(ids_line);
+    let end_line = stdout.lines().find(|l| l.starts_with("end: ")).expect("an end: line");
+    let end = fields(end_line);
+    let emitted: u64 = number(&end, "emitted", end_line);
+    let particles: u64 = number(&end, "particles", end_line);
+    assert!(emitted > 0 && particles > 0, "{end_line}");
+    assert_eq!(number::<u64>(&ids, "appeared", ids_line), emitted, "every emitted particle appears once: {ids_line}");
+    assert_eq!(number::<u64>(&ids, "last_id", ids_line), emitted, "ids 1 to the emitted count: {ids_line}");
+    assert_eq!(
+        number::<u64>(&ids, "gone", ids_line),
+        emitted - particles,
+        "the particles that left or died are those not seen again: {ids_line}"
+    );
+    assert!(number::<u64>(&ids, "moved", ids_line) > 10 * particles, "particles followed from step to step: {ids_line}");
+    assert!(number::<u64>(&ids, "wrapped", ids_line) > 0, "the breeze carries smoke round the periodic edge: {ids_line}");
+
+    let frames: Vec<&str> = stdout.lines().filter(|l| l.starts_with("frame: ")).collect();
+    assert_eq!(frames.len(), 3, "frames at 0, 100 and 200");
+    for (i, line) in frames.iter().enumerate() {
+        let f = fields(line);
+        let path = PathBuf::from(line["frame: ".len()..].split_whitespace().next().unwrap());
+        assert_eq!(path, out_dir.join(format!("smoke-ids-frame-{i:04}.png")));
+        let p = pngstat(&path);
+        assert_eq!((p.width, p.height), dims(&f, line), "{}", path.display());
+        let drawn: u64 = number(&f, "particles", line);
+        assert_eq!(drawn > 0, p.coloured > 0, "{}: {drawn} particles, {} coloured pixels", path.display(), p.coloured);
+    }
+    let sheet_line = stdout.lines().find(|l| l.starts_with("sheet: ")).expect("a sheet: line");
+    let sheet = pngstat(&PathBuf::from(sheet_line["sheet: ".len()..].split_whitespace().next().unwrap()));
+    assert_eq!((sheet.width, sheet.height), dims(&fields(sheet_line), sheet_line));
+    assert!(sheet.coloured > 0, "{sheet_line}");
+    let gif_line = stdout.lines().find(|l| l.starts_with("gif: ")).expect("a gif: line");
+    let g = pngstat(&out_dir.join("smoke-ids.gif"));
+    assert_eq!(g.frames, Some(10), "{gif_line}");
+    assert!(g.coloured > 0, "{gif_line}");
+}
+
 /// Progress: `--progress` reports on stderr at each tenth of the steps, in
 /// order, up to 100 %; `--quiet`, and the default when stderr is not a
 /// terminal (as here), say nothing. The world ends the same either way,
@@ -506,7 +562,7 @@ fn the_threads_example_equals_the_serial_step() {
 #[test]
 fn every_example_program_prints_its_version() {
     let expected = env!("CARGO_PKG_VERSION"); // the workspace's, as mpca-ffi's
-    for program in ["aggregation", "cluster", "smoke", "water", "threads", "cpp_example"] {
+    for program in ["aggregation", "cluster", "smoke", "water", "smoke-ids", "threads", "cpp_example"] {
         let out = run(program, &["--version"]);
         assert_eq!(out, format!("{program} (libmpca {expected})\n"), "{program} --version");
     }

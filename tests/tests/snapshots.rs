@@ -17,6 +17,9 @@ use mpca::{
 };
 use mpca_tests::scenes::{self, paper_scenes};
 
+mod common;
+use common::{crc32, reseal};
+
 // Offsets of the documented format (docs/model.md, M12).
 const VERSION_AT: usize = 8;
 const RESERVED_AT: usize = 12;
@@ -31,26 +34,6 @@ fn image(w: &World) -> Vec<u8> {
     let mut out = vec![0u8; w.snapshot_bytes()];
     assert_eq!(w.save(&mut out), Ok(out.len()));
     out
-}
-
-/// CRC-32 (zlib's), one bit at a time: written apart from the library's
-/// table-driven one, so the two check each other.
-fn crc32(bytes: &[u8]) -> u32 {
-    let mut r = u32::MAX;
-    for &b in bytes {
-        r ^= u32::from(b);
-        for _ in 0..8 {
-            r = (r >> 1) ^ (0xedb8_8320 & (r & 1).wrapping_neg());
-        }
-    }
-    !r
-}
-
-/// Writes a fresh checksum over a changed image.
-fn reseal(image: &mut [u8]) {
-    let n = image.len() - 4;
-    let crc = crc32(&image[..n]);
-    image[n..].copy_from_slice(&crc.to_le_bytes());
 }
 
 fn u32_at(image: &[u8], at: usize) -> u32 {

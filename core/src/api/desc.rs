@@ -114,6 +114,78 @@ pub struct Vortex {
     pub circulation: f32,
 }
 
+/// The identity planes a world keeps (M6b), each paid for only where it
+/// is on (M9): a 32-bit id unique in the world's life, the age in steps
+/// and a one-byte tag of the caller's, carried with every particle. A set
+/// of flags: [`Identity::IDS`], [`Identity::AGES`], [`Identity::TAGS`],
+/// joined with `|`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct Identity(u8);
+
+impl Identity {
+    /// No plane.
+    pub const NONE: Identity = Identity(0);
+    /// Each particle gets an id when it is added or emitted, counting up
+    /// from 1, never given again (4 bytes a cell).
+    pub const IDS: Identity = Identity(1);
+    /// Each particle counts the steps it has taken part in (4 bytes a
+    /// cell).
+    pub const AGES: Identity = Identity(2);
+    /// Each particle carries a byte the caller gives it: at
+    /// [`World::set_tag`](crate::World::set_tag) or from its emitter (1
+    /// byte a cell).
+    pub const TAGS: Identity = Identity(4);
+    /// Every plane.
+    pub const ALL: Identity = Identity(7);
+
+    /// The planes of `bits` (ids 1, ages 2, tags 4, as the C ABI's
+    /// `MPCA_IDENTITY_*`), or `None` where another bit is set.
+    pub const fn from_bits(bits: u32) -> Option<Identity> {
+        if bits & !7 == 0 { Some(Identity(bits as u8)) } else { None }
+    }
+
+    /// Ids 1, ages 2, tags 4.
+    pub const fn bits(self) -> u32 {
+        self.0 as u32
+    }
+
+    /// Whether every plane of `other` is in this set.
+    pub const fn contains(self, other: Identity) -> bool {
+        self.0 & other.0 == other.0
+    }
+
+    /// Whether particles carry ids.
+    #[inline(always)]
+    pub const fn ids(self) -> bool {
+        self.0 & 1 != 0
+    }
+
+    /// Whether particles carry ages.
+    #[inline(always)]
+    pub const fn ages(self) -> bool {
+        self.0 & 2 != 0
+    }
+
+    /// Whether particles carry tags.
+    #[inline(always)]
+    pub const fn tags(self) -> bool {
+        self.0 & 4 != 0
+    }
+
+    /// Whether any plane is on.
+    #[inline(always)]
+    pub const fn any(self) -> bool {
+        self.0 != 0
+    }
+}
+
+impl core::ops::BitOr for Identity {
+    type Output = Identity;
+    fn bitor(self, other: Identity) -> Identity {
+        Identity(self.0 | other.0)
+    }
+}
+
 /// Everything a world is built from. Start from [`Description::new_2d`] or
 /// [`Description::new_3d`] and change the fields a scene needs.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -177,6 +249,9 @@ pub struct Description {
     /// Whether particles carry a remaining lifetime (a `u16` per cell), so
     /// emitters can give them one (M6).
     pub lifetimes: bool,
+    /// Ids, ages and tags carried with the particles (M6b, feature
+    /// `identity`); none by default.
+    pub identity: Identity,
 }
 
 impl Description {
@@ -211,6 +286,7 @@ impl Description {
             energy_neutral: false,
             emitter_capacity: 0,
             lifetimes: false,
+            identity: Identity::NONE,
         }
     }
 
@@ -295,7 +371,8 @@ impl Description {
             && self.assignment() == self.method
             && self.collision_rule() == self.collisions
             && self.has_contacts() == self.contacts
-            && self.has_energy_neutral() == self.energy_neutral;
+            && self.has_energy_neutral() == self.energy_neutral
+            && self.identity_planes().any() == self.identity.any();
         if !kept {
             return Err(Error::FeatureDisabled);
         }
@@ -311,6 +388,13 @@ impl Description {
     #[inline(always)]
     pub(crate) const fn has_masses(&self) -> bool {
         cfg!(feature = "mass") && self.per_particle_mass
+    }
+
+    /// `identity`, none by construction in a build without the feature
+    /// `identity`, as [`Description::has_masses`].
+    #[inline(always)]
+    pub(crate) const fn identity_planes(&self) -> Identity {
+        if cfg!(feature = "identity") { self.identity } else { Identity::NONE }
     }
 
     /// `obstacles`, false by construction in a build without the feature

@@ -92,6 +92,9 @@ impl World {
         if self.is_obstacle(s) {
             return Err(Error::CellObstacle);
         }
+        if self.ids_left() == 0 {
+            return Err(Error::IdsExhausted);
+        }
         // Last fallible step (it checks the mass first); it changes the
         // world only when it succeeds.
         let index = self.mass_index_of(m)?;
@@ -101,28 +104,36 @@ impl World {
     }
 
     /// Writes an emitted particle into a free cell, its components rounded
-    /// stochastically from `rng` (M1). Not inlined into the step, whose
-    /// frame would grow by it, on firmware stacks too.
+    /// stochastically from `rng` (M1), with the mass index and tag of its
+    /// emitter's `class` ([`Slot::class`](crate::rules::emitter::Slot))
+    /// and lifetime `life`. Not inlined into the step, whose frame would
+    /// grow by it, on firmware stacks too.
     #[inline(never)]
-    pub(crate) fn place_emitted(&mut self, s: Site, x: [i32; 3], mass_index: u8, life: u16, rng: &mut crate::rules::rng::Stream) {
-        self.place(s, Velocity::Fine(x), mass_index, life, Some(rng));
+    pub(crate) fn place_emitted(&mut self, s: Site, x: [i32; 3], class: u32, life: u16, rng: &mut crate::rules::rng::Stream) {
+        self.place(s, Velocity::Fine(x), class as u8, life, (class >> 8) as u8, Some(rng));
     }
 
     /// Writes a particle a caller adds into a free cell, its components
     /// rounded to nearest. Apart from [`World::place_emitted`], so that a
     /// firmware that only emits does not carry this rounding.
     fn place_added(&mut self, s: Site, v: [f32; 3], mass_index: u8) {
-        self.place(s, Velocity::Float(v), mass_index, 0, None);
+        self.place(s, Velocity::Float(v), mass_index, 0, 0, None);
     }
 
-    /// Writes a particle into a free cell. Components in fine units are
-    /// rounded stochastically from `stream` (M1, M1c), floats to nearest.
+    /// Writes a particle into a free cell, with the next id where the
+    /// world gives ids (the caller made sure one is left), age 0 and `tag`
+    /// (M6b). Components in fine units are rounded stochastically from
+    /// `stream` (M1, M1c), floats to nearest.
     #[inline(always)]
-    fn place(&mut self, s: Site, v: Velocity, mass_index: u8, life: u16, stream: Option<&mut crate::rules::rng::Stream>) {
+    fn place(&mut self, s: Site, v: Velocity, mass_index: u8, life: u16, tag: u8, stream: Option<&mut crate::rules::rng::Stream>) {
         let d = self.dim();
         let summary_words = self.layout().summary_words;
         let per_mass = self.head.desc.has_masses();
         let lifetimes = self.head.desc.lifetimes;
+        let identity = self.head.desc.identity_planes();
+        if identity.any() {
+            self.identify(s.cell, tag);
+        }
         with_quant!(self.head.desc.quantization, Q => {
             let (_, p) = self.planes::<Q>();
             put_bit(Cells::new(p.occupancy), s.bit, true);
@@ -141,6 +152,56 @@ impl World {
                 p.life[s.cell] = life;
             }
         });
+    }
+
+    /// Gives the particle just placed in `cell` the next id, age 0 and
+    /// `tag`, in the planes the world keeps (M6b; the caller made sure an
+    /// id is left). Out of line: every way of placing a particle shares it.
+    #[inline(never)]
+    fn identify(&mut self, cell: usize, tag: u8) {
+        #[cfg(feature = "identity")]
+        {
+            let identity = self.head.desc.identity_planes();
+            let (head, p) = self.planes::<u8>();
+            if identity.ids() {
+                head.ids_given += 1;
+                p.id[cell] = head.ids_given;
+            }
+            if identity.ages() {
+                p.age[cell] = 0;
+            }
+            if identity.tags() {
+                p.tag[cell] = tag;
+            }
+        }
+        // Never called without the feature (no world has the planes).
+        #[cfg(not(feature = "identity"))]
+        let _ = (cell, tag);
+    }
+
+    /// How many ids are left to give (M6b): `u32::MAX` in a world without
+    /// ids, which never runs out.
+    pub(crate) fn ids_left(&self) -> u32 {
+        if self.head.desc.identity_planes().ids() { u32::MAX - self.head.ids_given } else { u32::MAX }
+    }
+
+    /// Gives the particle at `pos` the tag `tag` (M6b). Needs a world with
+    /// tags.
+    pub fn set_tag(&mut self, pos: [u32; 3], tag: u8) -> Result<(), Error> {
+        let s = self.locate(pos)?;
+        if !self.head.desc.identity_planes().tags() {
+            return Err(Error::NotEnabled);
+        }
+        if !self.occupied(s) {
+            return Err(Error::NoParticle);
+        }
+        #[cfg(feature = "identity")]
+        {
+            self.planes::<u8>().1.tag[s.cell] = tag;
+        }
+        #[cfg(not(feature = "identity"))]
+        let _ = tag; // refused above: no world has tags
+        Ok(())
     }
 
     /// Removes the particle at `pos` and returns it.

@@ -15,9 +15,9 @@ impl World {
         if used >= self.head.desc.emitter_capacity as usize {
             return Err(Error::EmitterTableFull);
         }
-        let mass_index = u32::from(self.mass_index_of(e.mass)?);
+        let mass_index = self.mass_index_of(e.mass)?;
         let (head, p) = self.planes::<u8>();
-        p.emitters[used] = Slot { emitter: e, mass_index };
+        p.emitters[used] = Slot { emitter: e, class: u32::from(mass_index) };
         head.emitters += 1;
         Ok(used)
     }
@@ -32,6 +32,20 @@ impl World {
             return Err(Error::OutOfBounds);
         }
         self.planes::<u8>().1.emitters[index].emitter.rate = rate;
+        Ok(())
+    }
+
+    /// Gives the particles emitter `index` places from now on the tag
+    /// `tag` (M6b); 0 until set. Needs a world with tags.
+    pub fn set_emitter_tag(&mut self, index: usize, tag: u8) -> Result<(), Error> {
+        if !self.head.desc.identity_planes().tags() {
+            return Err(Error::NotEnabled);
+        }
+        if index >= self.head.emitters as usize {
+            return Err(Error::OutOfBounds);
+        }
+        let slot = &mut self.planes::<u8>().1.emitters[index];
+        slot.class = u32::from(slot.mass_index()) | u32::from(tag) << 8;
         Ok(())
     }
 }

@@ -106,6 +106,9 @@ pub enum Error {
     /// The image holds a world of another size or plan of planes than the
     /// world it is loaded into (M12).
     ImageMismatch = 138,
+    /// Every id of the world's life was given: no particle can be added
+    /// (M6b).
+    IdsExhausted = 141,
 }
 
 /// The one table of messages. It writes both [`Error::c_message`], whose
@@ -171,6 +174,7 @@ messages! {
     ImageChecksum => c"the image's checksum does not match: it was damaged",
     ImageInvalid => c"the image does not hold a consistent world",
     ImageMismatch => c"the image holds a world of another size or layout than this one",
+    IdsExhausted => c"every particle id of the world's life was given",
 }
 
 impl Error {

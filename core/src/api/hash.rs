@@ -6,7 +6,8 @@ use crate::storage::world::World;
 
 impl World {
     /// A 64-bit FNV-1a hash over every particle's cell, stored velocity,
-    /// mass and lifetime, in cell order. Equal worlds hash equal on every
+    /// mass and lifetime, and its id, age and tag where the world keeps
+    /// them (M6b), in cell order. Equal worlds hash equal on every
     /// target.
     pub fn state_hash(&self) -> u64 {
         let mut h = Fnv(0xcbf2_9ce4_8422_2325);
@@ -29,6 +30,16 @@ impl World {
             });
             h.eat(self.mass_at(cell).to_bits(), 4);
             h.eat(u32::from(self.life_at(cell)), 2);
+            // M6b, where the world keeps them: a world without these planes
+            // hashes as before they existed.
+            let on = self.head.desc.identity_planes();
+            if on.any() {
+                // No byte of a plane the world does not keep.
+                let (id, age, tag) = self.identity_at(cell);
+                h.eat(id, 4 * u32::from(on.ids()));
+                h.eat(age, 4 * u32::from(on.ages()));
+                h.eat(u32::from(tag), u32::from(on.tags()));
+            }
         }
         h.0
     }

@@ -17,6 +17,13 @@ pub struct Particle {
     pub mass: f32,
     /// Steps left to live, 0 for no limit.
     pub life: u16,
+    /// Its id, unique in the world's life, from 1 (M6b); 0 in a world
+    /// without ids.
+    pub id: u32,
+    /// The steps it has taken part in (M6b); 0 in a world without ages.
+    pub age: u32,
+    /// The caller's tag (M6b); 0 in a world without tags.
+    pub tag: u8,
 }
 
 /// What one cell holds (M1).
@@ -124,8 +131,21 @@ impl World {
         if self.head.desc.lifetimes { self.plane::<u16>(self.layout().life())[cell] } else { 0 }
     }
 
+    /// The id, age and tag of the particle in `cell` (M6b), 0 for each
+    /// plane the world does not keep. Out of line: every particle a query
+    /// reads asks for them.
+    #[inline(never)]
+    pub(crate) fn identity_at(&self, cell: usize) -> (u32, u32, u8) {
+        let (l, on) = (self.layout(), self.head.desc.identity_planes());
+        let id = if on.ids() { self.plane::<u32>(l.id())[cell] } else { 0 };
+        let age = if on.ages() { self.plane::<u32>(l.age())[cell] } else { 0 };
+        let tag = if on.tags() { self.plane::<u8>(l.tag())[cell] } else { 0 };
+        (id, age, tag)
+    }
+
     pub(crate) fn particle_at(&self, pos: [u32; 3], cell: usize) -> Particle {
-        Particle { pos, velocity: self.velocity_at(cell), mass: self.mass_at(cell), life: self.life_at(cell) }
+        let (id, age, tag) = self.identity_at(cell);
+        Particle { pos, velocity: self.velocity_at(cell), mass: self.mass_at(cell), life: self.life_at(cell), id, age, tag }
     }
 
     /// What the cell at `pos` holds.
@@ -154,18 +174,20 @@ impl World {
     /// `res` bins per axis (x fastest; the third is 1 in 2D). Bin `i` along
     /// an axis of `n` cells covers cells `i n / r .. (i+1) n / r`.
     pub fn density(&self, res: [u32; 3], out: &mut [f32]) -> Result<(), Error> {
-        self.bin(res, out.len(), |i, hit, total| out[i] = hit as f32 / total as f32)
+        self.bin(res, out.len(), &mut |i, hit, total| out[i] = hit as f32 / total as f32)
     }
 
     /// As [`World::density`], scaled to `0..=255` for a texture upload.
     pub fn density_u8(&self, res: [u32; 3], out: &mut [u8]) -> Result<(), Error> {
         // In u64: hit * 255 can overflow a 32-bit usize.
-        self.bin(res, out.len(), |i, hit, total| {
+        self.bin(res, out.len(), &mut |i, hit, total| {
             out[i] = ((hit as u64 * 255 + total as u64 / 2) / total as u64) as u8
         })
     }
 
-    fn bin(&self, res: [u32; 3], len: usize, mut put: impl FnMut(usize, usize, usize)) -> Result<(), Error> {
+    /// The binning of both densities: `put(bin, hits, cells)` for each
+    /// bin. The writer is dynamic, so one copy serves both.
+    fn bin(&self, res: [u32; 3], len: usize, put: &mut dyn FnMut(usize, usize, usize)) -> Result<(), Error> {
         let l = *self.layout();
         let mut r = [1usize; 3];
         for k in 0..3 {
@@ -290,7 +312,9 @@ impl World {
     }
 }
 
-/// Set bits of `plane` in `bit .. bit + len`.
+/// Set bits of `plane` in `bit .. bit + len`. Out of line: one copy for
+/// both densities.
+#[inline(never)]
 fn count_bits(plane: &[u64], bit: usize, len: usize) -> usize {
     let mut n = 0;
     let mut at = bit;

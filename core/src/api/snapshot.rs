@@ -40,7 +40,7 @@
 use core::mem::size_of;
 
 use crate::Error;
-use crate::api::desc::{Boundary, Collisions, Description, Drag, Drift, Forces, Quantization, Vortex};
+use crate::api::desc::{Boundary, Collisions, Description, Drag, Drift, Forces, Identity, Quantization, Vortex};
 use crate::api::edit::storable;
 use crate::rules::assign::Method;
 use crate::rules::emitter::{checked, Emitter, Slot};
@@ -69,7 +69,8 @@ const FIXED: usize = HEAD + DESC + STATE;
 const CHECKSUM: usize = 4;
 /// One surface table entry: cell, normal, restitution, mask flag.
 const SURFACE: usize = 24;
-/// One emitter: region, rate, velocity, spread, mass, lifetime, mass index.
+/// One emitter: region, rate, velocity, spread, mass, lifetime, mass index
+/// and tag.
 const EMITTER: usize = 56;
 
 /// CRC-32 as zlib, PNG and Ethernet compute it: the reflected polynomial
@@ -215,11 +216,26 @@ fn each_bit(l: &Layout, word: impl Fn(usize) -> u64, mut f: impl FnMut(usize, us
     }
 }
 
+/// Calls `f(cell)` with the dense index of every cell set in the
+/// occupancy plane `occupancy` of a world planned as `l`, in cell order.
+/// Out of line, `f` dynamic: one copy serves every plane an image holds
+/// per particle.
+#[inline(never)]
+fn each_cell(l: &Layout, occupancy: &[u64], f: &mut dyn FnMut(usize)) {
+    each_bit(l, |i| occupancy[i], |row, x| f(x + l.n[0] * row));
+}
+
 /// Bytes of the image of a world described by `d`, planned as `l`, with
 /// these counts of particles and used table entries.
 fn image_len(d: &Description, l: &Layout, particles: usize, masses: usize, surfaces: usize, emitters: usize) -> Option<usize> {
     let (width, _) = width_and_scale(d.quantization);
-    let per_particle = d.dim as usize * width + usize::from(d.per_particle_mass) + 2 * usize::from(d.lifetimes);
+    let ids = d.identity;
+    let per_particle = d.dim as usize * width
+        + usize::from(d.per_particle_mass)
+        + 2 * usize::from(d.lifetimes)
+        + 4 * usize::from(ids.ids())
+        + 4 * usize::from(ids.ages())
+        + usize::from(ids.tags());
     [
         FIXED,
         l.occupancy().len,
@@ -265,6 +281,7 @@ fn put_desc(p: &mut Put<'_>, d: &Description) {
         drag,
         emitter_capacity,
         lifetimes,
+        identity,
     } = *d;
     let Forces { uniform, field, potential, vortex: swirl } = forces;
     let Vortex { centre, core_radius, circulation } = vortex;
@@ -299,7 +316,9 @@ fn put_desc(p: &mut Put<'_>, d: &Description) {
     // without a wind plane is the one an older library wrote, and an older
     // library refuses an image with one.
     p.u8(u8::from(wind_plane));
-    p.bytes(&[0; 3]);
+    // The second, likewise: the identity planes (M6b), a bit each.
+    p.u8(identity.bits() as u8);
+    p.bytes(&[0; 2]);
 }
 
 fn get_desc(g: &mut Get<'_>) -> Result<Description, Error> {
@@ -347,7 +366,8 @@ fn get_desc(g: &mut Get<'_>) -> Result<Description, Error> {
     let (restitution, wall_restitution, dt) = (g.f32()?, g.f32()?, g.f32()?);
     let (rate, wind) = (g.f32()?, [g.f32()?, g.f32()?, g.f32()?]);
     let drag = Drag { rate, wind, field: g.flag()?, vortex: flow };
-    g.zeros(3)?;
+    let identity = Identity::from_bits(u32::from(g.u8()?)).ok_or(bad)?;
+    g.zeros(2)?;
     Ok(Description {
         dim,
         size,
@@ -373,6 +393,7 @@ fn get_desc(g: &mut Get<'_>) -> Result<Description, Error> {
         drag,
         emitter_capacity,
         lifetimes,
+        identity,
     })
 }
 
@@ -396,7 +417,7 @@ fn put_slot(p: &mut Put<'_>, s: &Slot) {
     p.f32(e.spread);
     p.f32(e.mass);
     p.u32(e.lifetime);
-    p.u32(s.mass_index);
+    p.u32(s.class);
 }
 
 fn get_slot(b: &[u8]) -> Slot {
@@ -411,7 +432,7 @@ fn get_slot(b: &[u8]) -> Slot {
         mass: f(11),
         lifetime: u(12),
     };
-    Slot { emitter, mass_index: u(13) }
+    Slot { emitter, class: u(13) }
 }
 
 /// An image checked in full; its planes are still the image's bytes.
@@ -428,6 +449,14 @@ struct Image<'a> {
     velocity: &'a [u8],
     mass_index: &'a [u8],
     life: &'a [u8],
+    id: &'a [u8],
+    // Written into a world only where the build has the planes; without
+    // them `read` refuses an image that holds any.
+    #[cfg_attr(not(feature = "identity"), allow(dead_code))]
+    age: &'a [u8],
+    #[cfg_attr(not(feature = "identity"), allow(dead_code))]
+    tag: &'a [u8],
+    ids_given: u32,
     field: &'a [u8],
     potential: &'a [u8],
     wind: &'a [u8],
@@ -487,7 +516,11 @@ fn read(image: &[u8]) -> Result<Image<'_>, Error> {
     let counters =
         Counters { particles, emitted, exited, expired, shortfall, collisions, clamps, clamp_energy, displaced, processed, skipped };
     let [masses, surfaces, emitters] = [g.u32()?, g.u32()?, g.u32()?].map(|c| c as usize);
-    g.zeros(4)?;
+    // What was a reserved zero word: a world without ids gives none.
+    let ids_given = g.u32()?;
+    if !desc.identity.ids() && ids_given != 0 {
+        return Err(bad);
+    }
     let mass_room = if desc.per_particle_mass { 1..=desc.mass_classes as usize } else { 0..=0 };
     if !mass_room.contains(&masses)
         || surfaces > layout.surface().len / size_of::<Surface>()
@@ -515,6 +548,10 @@ fn read(image: &[u8]) -> Result<Image<'_>, Error> {
         velocity: g.take(n * dim * width)?,
         mass_index: g.take(if desc.per_particle_mass { n } else { 0 })?,
         life: g.take(if desc.lifetimes { 2 * n } else { 0 })?,
+        id: g.take(if desc.identity.ids() { 4 * n } else { 0 })?,
+        age: g.take(if desc.identity.ages() { 4 * n } else { 0 })?,
+        tag: g.take(if desc.identity.tags() { n } else { 0 })?,
+        ids_given,
         field: g.take(layout.field().len)?,
         potential: g.take(layout.potential().len)?,
         wind: g.take(layout.wind().len)?,
@@ -562,6 +599,12 @@ fn check(img: &Image<'_>) -> Result<(), Error> {
     if img.mass_index.iter().any(|&i| usize::from(i) >= img.masses) {
         return bad;
     }
+    // Ids that were given (M6b): from 1 to the count given. (That no two
+    // are equal is not checked: it would take memory or time a load does
+    // not have.)
+    if (0..img.id.len() / 4).any(|i| !(1..=img.ids_given).contains(&le_u32(img.id, i))) {
+        return bad;
+    }
 
     // Force and wind planes: finite, as the set functions require, and no
     // cell's wind faster than 1.
@@ -571,8 +614,11 @@ fn check(img: &Image<'_>) -> Result<(), Error> {
         return bad;
     }
     let wind_cell = |i: usize| -> [f32; 3] { core::array::from_fn(|k| if k < dim { float(img.wind, i + k) } else { 0.0 }) };
-    if !(0..img.wind.len() / 4).step_by(dim).all(|i| crate::api::speed::slow(&wind_cell(i)[..dim])) {
-        return bad;
+    // Cell by cell, `dim` values each.
+    for c in 0..img.wind.len() / 4 / dim {
+        if !crate::api::speed::slow(&wind_cell(c * dim)[..dim]) {
+            return bad;
+        }
     }
 
     // The mass table: distinct valid masses, class 0 the description's.
@@ -619,7 +665,12 @@ fn check(img: &Image<'_>) -> Result<(), Error> {
         if checked(&mut stored, dim, l.n, d.lifetimes).is_err() || stored != e {
             return bad;
         }
-        let class = s.mass_index as usize;
+        // The word of the mass class and the tag: two zero bytes above, and
+        // no tag where the world has none.
+        if s.class >> 16 != 0 || (s.tag() != 0 && !d.identity.tags()) {
+            return bad;
+        }
+        let class = usize::from(s.mass_index());
         let known = if d.per_particle_mass { class < img.masses && table(class).to_bits() == e.mass.to_bits() } else { class == 0 && e.mass.to_bits() == d.mass.to_bits() };
         if !known {
             return bad;
@@ -639,6 +690,7 @@ fn apply(w: &mut World, img: &Image<'_>) {
     w.head.masses = img.masses as u32;
     w.head.surfaces = img.surfaces as u32;
     w.head.emitters = img.emitters as u32;
+    w.head.ids_given = img.ids_given;
     // The velocities as bytes, written component by component in the
     // world's width (`store`): one copy of this for both widths.
     {
@@ -654,6 +706,12 @@ fn apply(w: &mut World, img: &Image<'_>) {
         p.velocity.fill(0);
         p.mass_index.fill(0);
         p.life.fill(0);
+        #[cfg(feature = "identity")]
+        {
+            p.id.fill(0);
+            p.age.fill(0);
+            p.tag.fill(0);
+        }
         // The skip summaries (M3), exact: flagged where a particle is.
         p.rows.fill(0);
         p.words.fill(0);
@@ -671,6 +729,20 @@ fn apply(w: &mut World, img: &Image<'_>) {
             }
             if d.lifetimes {
                 p.life[cell] = u16::from_le_bytes([img.life[2 * i], img.life[2 * i + 1]]);
+            }
+            // M6b: an image with these planes reads only where they are
+            // built (`read` refuses others).
+            #[cfg(feature = "identity")]
+            {
+                if d.identity.ids() {
+                    p.id[cell] = le_u32(img.id, i);
+                }
+                if d.identity.ages() {
+                    p.age[cell] = le_u32(img.age, i);
+                }
+                if d.identity.tags() {
+                    p.tag[cell] = img.tag[i];
+                }
             }
             i += 1;
         });
@@ -702,6 +774,8 @@ fn apply(w: &mut World, img: &Image<'_>) {
 fn ones(words: &[u64]) -> usize {
     words.iter().map(|w| w.count_ones() as usize).sum()
 }
+
+
 
 /// The description of the world `image` holds, after checking the whole
 /// image as [`World::load`] does. [`crate::world_bytes`] of it is the memory
@@ -746,14 +820,15 @@ impl World {
         for c in [displaced, processed, skipped] {
             p.u64(c);
         }
-        for c in [h.masses, h.surfaces, h.emitters, 0] {
+        for c in [h.masses, h.surfaces, h.emitters, h.ids_given] {
             p.u32(c);
         }
         let occupancy: &[u64] = self.plane(l.occupancy());
         occupancy.iter().for_each(|&w| p.u64(w));
         self.plane::<u64>(l.obstacle()).iter().for_each(|&w| p.u64(w));
-        // Per particle, in cell order: velocities, mass classes, lifetimes.
-        let each_particle = |f: &mut dyn FnMut(usize)| each_bit(&l, |i| occupancy[i], |row, x| f(x + l.n[0] * row));
+        // Per particle, in cell order: velocities, mass classes, lifetimes,
+        // then ids, ages and tags.
+        let each_particle = |f: &mut dyn FnMut(usize)| each_cell(&l, occupancy, f);
         with_quant!(h.desc.quantization, Q => {
             let v: &[Q] = self.plane(l.velocity());
             each_particle(&mut |cell| {
@@ -770,6 +845,17 @@ impl World {
         if h.desc.lifetimes {
             let life: &[u16] = self.plane(l.life());
             each_particle(&mut |cell| p.bytes(&life[cell].to_le_bytes()));
+        }
+        // M6b: ids, ages, tags.
+        for plane in [l.id(), l.age()] {
+            let values: &[u32] = self.plane(plane);
+            if !values.is_empty() {
+                each_particle(&mut |cell| p.u32(values[cell]));
+            }
+        }
+        let tag: &[u8] = self.plane(l.tag());
+        if !tag.is_empty() {
+            each_particle(&mut |cell| p.u8(tag[cell]));
         }
         self.plane::<f32>(l.field()).iter().for_each(|&f| p.f32(f));
         self.plane::<f32>(l.potential()).iter().for_each(|&u| p.f32(u));

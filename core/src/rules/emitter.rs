@@ -38,7 +38,22 @@ pub struct Emitter {
 #[repr(C)]
 pub(crate) struct Slot {
     pub emitter: Emitter,
-    pub mass_index: u32,
+    /// The mass index of its particles in the low byte, and in the next
+    /// the tag they carry where the world has tags (M6b): the word an
+    /// image holds (M12).
+    pub class: u32,
+}
+
+impl Slot {
+    #[inline(always)]
+    pub(crate) fn mass_index(&self) -> u8 {
+        self.class as u8
+    }
+
+    #[inline(always)]
+    pub(crate) fn tag(&self) -> u8 {
+        (self.class >> 8) as u8
+    }
 }
 
 /// `e` as a world of `dim` dimensions, `n` cells per axis and, if

@@ -215,6 +215,12 @@ pub(crate) struct Shared<'a> {
     /// `plain` without contacts (M5.7): what the lanes representation
     /// (`lanes::Lanes`) needs of the step, tested once a row.
     pub lanes: bool,
+    /// The identity planes (M6b), which only the blocks with every part
+    /// write: here rather than beside the other planes in [`Writable`],
+    /// whose size the plain blocks' sweep feels. Not in a build without
+    /// `identity` (firmware), whose setup would store it for nothing.
+    #[cfg(feature = "identity")]
+    pub identity: Identified<'a>,
 }
 
 /// The planes a step writes; `velocity` holds a cell's `D` components
@@ -228,6 +234,17 @@ pub(crate) struct Writable<'a, Q, const D: usize> {
     pub velocity: Cells<'a, [Q; D]>,
     pub mass_index: Cells<'a, u8>,
     pub life: Cells<'a, u16>,
+}
+
+/// The identity planes a step writes (M6b, `step/identity.rs`), to
+/// disjoint cells from each task as [`Writable`]'s; empty where the world
+/// has none.
+#[cfg(feature = "identity")]
+#[derive(Clone, Copy)]
+pub(crate) struct Identified<'a> {
+    pub id: Cells<'a, u32>,
+    pub age: Cells<'a, u32>,
+    pub tag: Cells<'a, u8>,
 }
 
 /// A block's stored velocities (in quanta) as the pipeline holds them

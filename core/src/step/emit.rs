@@ -27,7 +27,13 @@ impl World {
             // those in pairs of instructions).
             let mut free = 0usize;
             each_site(grid, &e, |s| free += usize::from(!self.occupied(s) && !self.is_obstacle(s)));
-            let placing = wanted.min(free as u64) as usize;
+            let mut placing = wanted.min(free as u64);
+            // M6b: no more particles than ids are left; the rest is
+            // shortfall as well.
+            if self.head.desc.identity_planes().ids() {
+                placing = placing.min(u64::from(self.ids_left()));
+            }
+            let placing = placing as usize;
             self.head.counters.shortfall = self.head.counters.shortfall.saturating_add(wanted - placing as u64);
             let mut need = placing;
             let mut left = free;
@@ -43,7 +49,7 @@ impl World {
                 if take {
                     need -= 1;
                     let v = spread_velocity(&e, dim, unit, &mut rng);
-                    w.place_emitted(s, v, slot.mass_index as u8, e.lifetime as u16, &mut rng);
+                    w.place_emitted(s, v, slot.class, e.lifetime as u16, &mut rng);
                 }
             };
             each_site(grid, &e, |s| chosen(self, s));

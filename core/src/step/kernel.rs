@@ -53,12 +53,15 @@
 //!
 //! M5.1 draws nothing.
 
+use crate::api::desc::Identity;
 use crate::rules::collision::pick_pair;
 use crate::rules::faces::{resolve, Beyond};
 use crate::rules::quant::Quant;
 use crate::rules::rng::Stream;
 use crate::step::assign::{stored_speed2, FIELDS, IDENTITY};
 use crate::step::block::{cells_of, each_occupied, Bare, Block, Carried, Every, Kernel, Parts, Plain, Site, Stored};
+#[cfg(feature = "identity")]
+use crate::step::identity::carry;
 use crate::step::contacts::contacts;
 use crate::step::lanes::Lanes;
 use crate::step::partition::{cells_at, BlockRow, BlockSink, Index};
@@ -288,7 +291,10 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
         // Nothing to write where nobody moves and no velocity changed. Not
         // tested with `small-step`: the write back below changes nothing
         // then, and the test takes flash.
-        if !cfg!(feature = "small-step") && (targets ^ IDENTITY) & FIELDS[usize::from(occ)] == 0 && b.dirty() == 0 && !carried.lifetimes {
+        // M6b: a plain world has no ids, ages or tags (not read for its
+        // blocks).
+        let on = if P::ALL { sh.desc.identity_planes() } else { Identity::NONE };
+        if !cfg!(feature = "small-step") && (targets ^ IDENTITY) & FIELDS[usize::from(occ)] == 0 && b.dirty() == 0 && !carried.lifetimes && !on.ages() {
             return;
         }
         let mut after = 0u8;
@@ -312,6 +318,10 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
                 }
             }
         });
+        #[cfg(feature = "identity")]
+        if P::ALL && on.any() {
+            carry(sh.identity, site, occ, after, targets, on);
+        }
         self.occupy(site, occ, after);
     }
 

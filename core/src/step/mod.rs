@@ -17,6 +17,8 @@ pub(crate) mod collision;
 pub(crate) mod contacts;
 pub(crate) mod emit;
 pub(crate) mod force;
+#[cfg(feature = "identity")]
+pub(crate) mod identity;
 pub(crate) mod kernel;
 pub(crate) mod lanes;
 pub(crate) mod moves;
@@ -31,6 +33,8 @@ use crate::rules::force::{Flow, ForceTerms, Swirl};
 use crate::rules::quant::Quant;
 use crate::rules::rng::StepKey;
 use crate::rules::class::Class;
+#[cfg(feature = "identity")]
+use crate::step::block::Identified;
 use crate::step::block::{Shared, Writable};
 use crate::step::block::Kernel;
 use crate::step::partition::Partition;
@@ -248,7 +252,7 @@ impl World {
         // With `small-step` every block takes the pipeline with every part:
         // nothing is plain, and nothing only the plain ones read is set up.
         let lean = !cfg!(feature = "small-step") && route.lean;
-        let plain = lean && !desc.has_masses() && !desc.lifetimes && !summed && small_push;
+        let plain = lean && !desc.has_masses() && !desc.lifetimes && !desc.identity_planes().any() && !summed && small_push;
         let shared = Shared {
             #[cfg(feature = "small-step")]
             desc,
@@ -284,6 +288,8 @@ impl World {
             summed,
             plain,
             lanes: plain && !desc.has_contacts(),
+            #[cfg(feature = "identity")]
+            identity: Identified { id: Cells::new(p.id), age: Cells::new(p.age), tag: Cells::new(p.tag) },
         };
         Setup {
             counters,

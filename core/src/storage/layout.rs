@@ -119,8 +119,9 @@ pub(crate) struct Layout {
     pub total: usize,
 }
 
-/// The number of planes of a [`Layout`].
-const PLANES: usize = 13;
+/// The number of planes of a [`Layout`]: the identity planes (M6b), last,
+/// only in a build with `identity`, so firmware without it plans as before.
+const PLANES: usize = if cfg!(feature = "identity") { 16 } else { 13 };
 
 /// A getter for each plane of a [`Layout`], by its index in `plane`.
 macro_rules! planes {
@@ -160,6 +161,27 @@ planes! {
 }
 
 impl Layout {
+    /// M6b's planes, a `u32` id, a `u32` age and a `u8` tag per cell:
+    /// empty in a build without `identity`.
+    #[inline]
+    fn identity_plane(&self, i: usize) -> Plane {
+        self.plane.get(13 + i).copied().unwrap_or_default()
+    }
+    #[inline]
+    pub(crate) fn id(&self) -> Plane {
+        self.identity_plane(0)
+    }
+    #[inline]
+    pub(crate) fn age(&self) -> Plane {
+        self.identity_plane(1)
+    }
+    #[inline]
+    pub(crate) fn tag(&self) -> Plane {
+        self.identity_plane(2)
+    }
+}
+
+impl Layout {
     /// Checks `d` ([`Description::check`]) and plans its memory. Every
     /// size computation is checked, so a description whose byte count would
     /// overflow is refused.
@@ -191,7 +213,9 @@ impl Layout {
         let per_cell = |bytes: usize, on: bool| mul(cells, bytes * usize::from(on));
         let summary_words = row_words.div_ceil(64);
         // The planes' lengths in the order they lie in memory, each
-        // starting 8-byte aligned after the one before.
+        // starting 8-byte aligned after the one before; M6b's last, and
+        // only in a build with `identity` (a build without refuses them,
+        // `Description::check`).
         let lens = [
             bit_plane,
             rows,
@@ -206,6 +230,12 @@ impl Layout {
             if d.per_particle_mass { mass_plane(d.mass_classes as usize) } else { 0 },
             mul(d.surface_capacity as usize * usize::from(d.obstacles), size_of::<crate::rules::obstacle::Surface>())?,
             mul(d.emitter_capacity as usize, size_of::<crate::rules::emitter::Slot>())?,
+            #[cfg(feature = "identity")]
+            per_cell(4, d.identity.ids())?,
+            #[cfg(feature = "identity")]
+            per_cell(4, d.identity.ages())?,
+            #[cfg(feature = "identity")]
+            per_cell(1, d.identity.tags())?,
         ];
         let mut plane = lens.map(|len| Plane { off: 0, len });
         let mut at = 0usize;
@@ -266,6 +296,14 @@ pub(crate) struct Planes<'a, Q> {
     pub velocity: &'a mut [Q],
     pub mass_index: &'a mut [u8],
     pub life: &'a mut [u16],
+    /// M6b's planes, in a build with `identity` alone: firmware without it
+    /// hands no empty slices about.
+    #[cfg(feature = "identity")]
+    pub id: &'a mut [u32],
+    #[cfg(feature = "identity")]
+    pub age: &'a mut [u32],
+    #[cfg(feature = "identity")]
+    pub tag: &'a mut [u8],
     pub field: &'a mut [f32],
     pub potential: &'a mut [f32],
     pub wind: &'a mut [f32],
@@ -293,7 +331,7 @@ pub(crate) struct Site {
 /// components (1, or 2 in the target's byte order) viewed as bytes: `q`,
 /// in quanta, within the width's range. Callers that hold the plane as
 /// bytes have one copy of their code for both widths.
-#[inline]
+#[inline(always)]
 pub(crate) fn store(plane: &mut [u8], i: usize, width: usize, q: i32) {
     if width == 1 || !cfg!(feature = "q16") {
         plane[i] = q as i8 as u8;

@@ -13,6 +13,7 @@ unsafe impl Plain for u8 {}
 unsafe impl Plain for i8 {}
 unsafe impl Plain for u16 {}
 unsafe impl Plain for i16 {}
+unsafe impl Plain for u32 {}
 unsafe impl Plain for u64 {}
 unsafe impl Plain for f32 {}
 // SAFETY: an array of plain values is plain: no padding between elements,

@@ -70,6 +70,10 @@ pub(crate) struct Header {
     pub emitters: u32,
     /// 1 when the library allocated the memory (`WorldBox`, feature `alloc`).
     pub owned: u32,
+    /// How many ids were given (M6b): the next particle added or emitted
+    /// takes this plus 1, and none is left at `u32::MAX`. 0 in a new world
+    /// (the zeroed header) and in every world without ids.
+    pub ids_given: u32,
 }
 
 const TAG: u64 = 0x6d70_6361_776f_726c; // "mpcaworl"
@@ -223,8 +227,45 @@ impl World {
         if cfg!(feature = "dim3") { self.head.desc.dim as usize } else { 2 }
     }
 
-    /// The header and every plane, borrowed apart.
+    /// The header and every plane, borrowed apart, the velocities as `Q`.
+    /// Hosted builds split the memory in one routine for every velocity
+    /// type ([`World::split`] with bytes) and view the velocities after;
+    /// firmware, which has one width and calls this from few places, splits
+    /// in place: a call, and the planes handed back through memory, take
+    /// more flash there than the copies.
+    #[inline]
     pub(crate) fn planes<Q: Plain>(&mut self) -> (&mut Header, Planes<'_, Q>) {
+        if cfg!(feature = "small-step") {
+            return self.split::<Q>();
+        }
+        let (head, p) = self.split::<u8>();
+        let planes = Planes {
+            occupancy: p.occupancy,
+            rows: p.rows,
+            words: p.words,
+            obstacle: p.obstacle,
+            velocity: view(p.velocity),
+            mass_index: p.mass_index,
+            life: p.life,
+            field: p.field,
+            potential: p.potential,
+            wind: p.wind,
+            mass_table: p.mass_table,
+            surface: p.surface,
+            emitters: p.emitters,
+            #[cfg(feature = "identity")]
+            id: p.id,
+            #[cfg(feature = "identity")]
+            age: p.age,
+            #[cfg(feature = "identity")]
+            tag: p.tag,
+        };
+        (head, planes)
+    }
+
+    /// [`World::planes`]' split of the memory.
+    #[cfg_attr(not(feature = "small-step"), inline(never))]
+    fn split<Q: Plain>(&mut self) -> (&mut Header, Planes<'_, Q>) {
         let l = self.head.layout;
         let mut rest: &mut [u8] = &mut self.mem;
         let mut at = 0usize;
@@ -255,6 +296,14 @@ impl World {
             mass_table: if mass { view(take(l.mass_table())) } else { &mut [] },
             surface: if obstacles { view(take(l.surface())) } else { &mut [] },
             emitters: view_counted(take(l.emitters()), self.head.desc.emitter_capacity as usize),
+            // M6b's planes lie last (`Layout::of`), and are taken in that
+            // order.
+            #[cfg(feature = "identity")]
+            id: view(take(l.id())),
+            #[cfg(feature = "identity")]
+            age: view(take(l.age())),
+            #[cfg(feature = "identity")]
+            tag: take(l.tag()),
         };
         (&mut self.head, planes)
     }

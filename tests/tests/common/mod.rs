@@ -98,3 +98,23 @@ pub fn description_floats() -> [(&'static str, Setter); 12] {
         }),
     ]
 }
+
+/// CRC-32 (zlib's), one bit at a time: written apart from the library's
+/// table-driven one, so the two check each other.
+pub fn crc32(bytes: &[u8]) -> u32 {
+    let mut r = u32::MAX;
+    for &b in bytes {
+        r ^= u32::from(b);
+        for _ in 0..8 {
+            r = (r >> 1) ^ (0xedb8_8320 & (r & 1).wrapping_neg());
+        }
+    }
+    !r
+}
+
+/// Writes a fresh checksum over a changed world image (M12).
+pub fn reseal(image: &mut [u8]) {
+    let n = image.len() - 4;
+    let crc = crc32(&image[..n]);
+    image[n..].copy_from_slice(&crc.to_le_bytes());
+}
