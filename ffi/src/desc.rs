@@ -241,7 +241,7 @@ impl mpca_desc {
             drag_wind: d.drag.wind,
             drag_vortex: d.drag.vortex as u32,
             drag_wind_field: d.drag.field as u32,
-            identity: 0,
+            identity: d.identity.bits(),
         }
     }
 

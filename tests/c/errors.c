@@ -1295,6 +1295,10 @@ static const struct {
 
 static void identity_cases(void) {
     uint32_t particle[3] = {4, 8, 0}, empty[3] = {1, 12, 0}, outside[3] = {N2, 0, 0};
+    set_context("the description reports the planes");
+    mpca_desc d;
+    CHECK_OK(mpca_world_desc(full2, &d));
+    CHECK(d.identity == (MPCA_IDENTITY_IDS | MPCA_IDENTITY_AGES | MPCA_IDENTITY_TAGS));
     set_context("mpca_world_set_tag");
     REFUSED(MPCA_STATUS_TAG_RANGE, mpca_world_set_tag(full2, particle, 256));
     REFUSED(MPCA_STATUS_TAG_RANGE, mpca_world_set_tag(full2, particle, UINT32_MAX));
