@@ -1,7 +1,7 @@
 //! Particles: adding, removing, reading cells, and export into caller arrays
 //! for vertex buffers and textures.
 
-use mpca_core::{Cell, Particle};
+use mpca_core::{Cell, Particle, World};
 
 use crate::snapshot::overlap;
 use crate::{check_size, guard, mpca_status, mpca_world, Call};
@@ -152,24 +152,36 @@ fn export(
     put: impl Fn(&Particle, &mut [f32]),
 ) -> Result<(), mpca_status> {
     let w = c.world_ref(world)?;
-    let count = c.out(out_count)?;
-    if out.is_null() && capacity != 0 {
-        return Err(mpca_status::NullPointer);
-    }
-    let n = w.particle_count() as usize;
-    count.set(n);
-    if out.is_null() {
+    let Some(n) = counted(c, w, !out.is_null(), capacity, out_count)? else {
         return Ok(()); // the size query
-    }
-    if capacity < n {
-        return Err(mpca_status::OutputTooSmall);
-    }
+    };
     let floats = n.checked_mul(per).ok_or(mpca_status::OutputTooSmall)?;
     let dst = c.slice_mut(out, floats, mpca_status::OutputTooSmall)?;
     for (p, chunk) in w.particles().zip(dst.chunks_exact_mut(per)) {
         put(&p, chunk);
     }
     Ok(())
+}
+
+/// What every export does before it writes: the particle count to
+/// `out_count`, and `Some` of it where there is somewhere to write
+/// (`has_output`) with room for it; `None` for the size query (nowhere to
+/// write, `capacity` 0); NULL with room claimed refused before the count
+/// is written, a capacity below the count after.
+fn counted(c: &Call<'_>, w: &World, has_output: bool, capacity: usize, out_count: *mut usize) -> Result<Option<usize>, mpca_status> {
+    let count = c.out(out_count)?;
+    if !has_output && capacity != 0 {
+        return Err(mpca_status::NullPointer);
+    }
+    let n = w.particle_count() as usize;
+    count.set(n);
+    if !has_output {
+        return Ok(None);
+    }
+    if capacity < n {
+        return Err(mpca_status::OutputTooSmall);
+    }
+    Ok(Some(n))
 }
 
 /// Particle positions as 3 floats each (cell centres: x + 0.5, y + 0.5,
@@ -269,17 +281,10 @@ pub unsafe extern "C" fn mpca_world_export_particles(
         if missing(!cols.ids.is_null(), on.ids()) || missing(!cols.ages.is_null(), on.ages()) || missing(!cols.tags.is_null(), on.tags()) {
             return Err(mpca_core::Error::NotEnabled.into());
         }
-        let count = c.out(out_count)?;
-        let none = cols.positions.is_null() && cols.velocities.is_null() && cols.ids.is_null() && cols.ages.is_null() && cols.tags.is_null();
-        let n = w.particle_count() as usize;
-        count.set(n);
-        if none {
-            // The size query; room claimed for no column is a NULL column.
-            return if capacity == 0 { Ok(()) } else { Err(mpca_status::NullPointer) };
-        }
-        if capacity < n {
-            return Err(mpca_status::OutputTooSmall);
-        }
+        let some = !(cols.positions.is_null() && cols.velocities.is_null() && cols.ids.is_null() && cols.ages.is_null() && cols.tags.is_null());
+        let Some(n) = counted(c, w, some, capacity, out_count)? else {
+            return Ok(()); // the size query
+        };
         let too_small = mpca_status::OutputTooSmall;
         let triples = n.checked_mul(3).ok_or(too_small)?;
         // Each column is its own array: two that share a byte are refused

@@ -1370,6 +1370,7 @@ static void identity_cases(void) {
     CHECK(count == n);
     count = SENTINEL_SIZE;
     REFUSED(MPCA_STATUS_NULL_POINTER, mpca_world_export_particles(full2, &none, n, &count));
+    CHECK(count == SENTINEL_SIZE); /* as the other exports: refused before the count */
 
     /* The export itself: the twins' positions and velocities, the cells'
      * ids, ages and tags, in one order; ids positive and distinct. */

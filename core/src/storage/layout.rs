@@ -119,9 +119,11 @@ pub(crate) struct Layout {
     pub total: usize,
 }
 
+/// The planes every build plans, the getters of `planes!` below.
+const BASE_PLANES: usize = 13;
 /// The number of planes of a [`Layout`]: the identity planes (M6b), last,
 /// only in a build with `identity`, so firmware without it plans as before.
-const PLANES: usize = if cfg!(feature = "identity") { 16 } else { 13 };
+const PLANES: usize = BASE_PLANES + if cfg!(feature = "identity") { 3 } else { 0 };
 
 /// A getter for each plane of a [`Layout`], by its index in `plane`.
 macro_rules! planes {
@@ -165,7 +167,7 @@ impl Layout {
     /// empty in a build without `identity`.
     #[inline]
     fn identity_plane(&self, i: usize) -> Plane {
-        self.plane.get(13 + i).copied().unwrap_or_default()
+        self.plane.get(BASE_PLANES + i).copied().unwrap_or_default()
     }
     #[inline]
     pub(crate) fn id(&self) -> Plane {
