@@ -1,6 +1,8 @@
 //! A mass class as the rules read it during a step: the constants of one
 //! mass, converted from it once a step (M1c).
 
+use crate::rules::force::Strength;
+
 /// A mass class as a step's blocks read it, converted from its mass once a
 /// step (M1c). Laid out without padding: the classes of a world of masses
 /// lie in its memory ([`mass_plane`](crate::storage::layout::mass_plane)).
@@ -17,9 +19,9 @@ pub(crate) struct Class {
     /// Units of the clamp's energy counter a fine unit squared of speed
     /// removed is worth: `m 2^31 / W^2` (M5.5, M10), by [`quot`](crate::rules::fixed::quot).
     pub energy: f32,
-    /// Unused: brings `swirl` to its alignment.
+    /// Unused: keeps a class the size the mass table's plane gives it.
     pub spare: u32,
-    /// The vortex's strength as a push for this class (M1c's `Γ'`), 0
-    /// without a vortex.
-    pub swirl: i64,
+    /// The vortex's strength as a push for this class (M1c's `top(Γ')`),
+    /// none without a vortex.
+    pub swirl: Strength,
 }

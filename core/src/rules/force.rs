@@ -6,7 +6,7 @@
 //! velocities towards (M5.1b).
 
 use crate::api::desc::Vortex;
-use crate::rules::fixed::{magnitude, quot, sat, scaled, scaled_by, to_fine, udiv, SCALED_MAX};
+use crate::rules::fixed::{magnitude, quot, sat, scaled, scaled_by, to_fine, SCALED_MAX};
 use crate::rules::class::Class;
 
 /// The force terms of one step, read-only, for the general force path.
@@ -89,7 +89,7 @@ pub(crate) struct Flow<'a> {
     pub wind: [i32; 3],
     pub field: Option<&'a [f32]>,
     /// The vortex and its strength as a velocity (M1c's `Γ''`).
-    pub vortex: Option<(Swirl, i64)>,
+    pub vortex: Option<(Swirl, Strength)>,
     /// Fine units to a unit speed, `W = S 2^F`, as `(S, F)`.
     pub unit: (u32, i32),
     pub dim: usize,
@@ -124,8 +124,8 @@ impl Flow<'_> {
 pub(crate) struct Swirl {
     /// The centre, `round(c 2^8)`.
     centre: [i64; 2],
-    /// `round(R 2^8)^2`.
-    core2: i64,
+    /// `round(R 2^8)`, at most [`REACH`].
+    core: u32,
     /// `G / (2 pi)` ([`quot`]), the one float the pushes are converted
     /// from.
     strength: f32,
@@ -135,13 +135,38 @@ pub(crate) struct Swirl {
 /// cells, beyond which a cell's offset is cut.
 const REACH: i64 = 1 << 28;
 
+/// A vortex's strength as a push (M1c's `Γ'` or `Γ''`) kept as its top 16
+/// bits and their place, `g 2^e` with `2^15 <= |g| < 2^16` (`g` 0 for no
+/// strength), so that a particle's push needs only 32-bit products.
+#[derive(Clone, Copy, Default)]
+#[repr(C)]
+pub(crate) struct Strength {
+    /// The top 16 bits of the magnitude, with the strength's sign.
+    g: i32,
+    /// The place of `g`'s lowest bit.
+    e: i32,
+}
+
+impl Strength {
+    /// M1c's `top(x)`: the top 16 bits of `|x|`, rounded down.
+    pub(crate) fn of(x: i64) -> Strength {
+        let m = x.unsigned_abs();
+        if m == 0 {
+            return Strength::default();
+        }
+        let b = 64 - m.leading_zeros() as i32;
+        let g = if b > 16 { m >> (b - 16) } else { m << (16 - b) } as i32;
+        Strength { g: if x < 0 { -g } else { g }, e: b - 16 }
+    }
+}
+
 impl Swirl {
     /// The vortex `v` converted.
     pub(crate) fn of(v: &Vortex) -> Swirl {
         let core = scaled(v.core_radius, 1.0, 8).clamp(0, REACH);
         Swirl {
             centre: [scaled(v.centre[0], 1.0, 8), scaled(v.centre[1], 1.0, 8)],
-            core2: core * core,
+            core: core as u32,
             strength: {
                 let q = quot(magnitude(v.circulation), magnitude(core::f32::consts::TAU), 0);
                 if v.circulation.is_sign_negative() { -q } else { q }
@@ -151,50 +176,86 @@ impl Swirl {
 
     /// The strength in fine units per `2^-8` cell for a factor `k` in a
     /// world whose unit speed is `(s, fine)` ([`unit_scale`](crate::rules::fixed::unit_scale)):
-    /// M1c's `Γ' = conv(G / (2 pi), k W, 8)`, saturated at `2^59`.
+    /// M1c's `top(conv(G / (2 pi), k W, 8))`.
     #[inline]
-    pub(crate) fn gamma(&self, k: f32, (s, fine): (u32, i32)) -> i64 {
-        scaled_by(self.strength, k, s, fine + 8)
+    pub(crate) fn gamma(&self, k: f32, (s, fine): (u32, i32)) -> Strength {
+        Strength::of(scaled_by(self.strength, k, s, fine + 8))
     }
 
-    /// The push at the centre of cell `pos` for strength `gamma`, each
-    /// component `gamma d / max(|d|^2, R^2)` rounded toward zero, so that
-    /// the field stays antisymmetric about the centre ([`ratio`]). Zero at
-    /// the centre, for any core.
+    /// The push at the centre of cell `pos` for strength `gamma`: each
+    /// component `gamma d / max(|d|^2, R^2)`, its magnitude rounded down
+    /// and the sign applied after, so that the field stays antisymmetric
+    /// about the centre (M1c gives every rounding). The offsets are cut
+    /// to 15 bits and the squared length to its top 16, so that every
+    /// product and the one division fit 32 bits (a GPU has no wider
+    /// integers, a small core no 64-bit divide).
     #[inline]
-    pub(crate) fn at(&self, pos: [usize; 3], gamma: i64) -> [i64; 2] {
+    pub(crate) fn at(&self, pos: [usize; 3], gamma: Strength) -> [i64; 2] {
         let d = |a: usize| (((pos[a] as i64) << 8) + 128 - self.centre[a]).clamp(-REACH, REACH);
         let (dx, dy) = (d(0), d(1));
-        let r2 = ((dx * dx + dy * dy) as u64).max(self.core2 as u64);
-        if r2 == 0 {
+        let (ax, ay) = (dx.unsigned_abs() as u32, dy.unsigned_abs() as u32);
+        let big = ax.max(ay).max(self.core);
+        if big == 0 || gamma.g == 0 {
             return [0, 0];
         }
-        let g = gamma.unsigned_abs();
-        let signed = |d: i64, negative: bool| {
-            let m = ratio(g, d.unsigned_abs(), r2) as i64;
-            if negative != (gamma < 0) { -m } else { m }
+        let cut = (32 - big.leading_zeros()).saturating_sub(15);
+        let (ax, ay, core) = (ax >> cut, ay >> cut, self.core >> cut);
+        let n = (ax * ax + ay * ay).max(core * core);
+        let b = 32 - n.leading_zeros() as i32;
+        let top = if b > 16 { n >> (b - 16) } else { n << (16 - b) };
+        let f = share(gamma.g.unsigned_abs() << 15, top);
+        let e = gamma.e - cut as i32 - b + 1;
+        let signed = |a: u32, negative: bool| {
+            let y = u64::from(f * a);
+            let m = if e < 0 { y >> -e } else if y > SCALED_MAX >> e { SCALED_MAX } else { y << e } as i64;
+            if negative != (gamma.g < 0) { -m } else { m }
         };
-        [signed(dy, dy > 0), signed(dx, dx < 0)]
+        [signed(ay, dy > 0), signed(ax, dx < 0)]
     }
 }
 
-/// `g a / r2` rounded down, for `g` up to `2^59`, `a` up to `2^28` and
-/// `r2` from 1 to `2^57`, without a product wider than 64 bits: the whole
-/// part of `g / r2` times `a`, saturating, plus the remainder's share
-/// (exact while `r2` is below `2^35`: cells within 724 of the centre),
-/// with the remainder and `r2` cut to 35 bits first, which may move the
-/// result by a unit. The result saturates at `2^59`.
-fn ratio(g: u64, a: u64, r2: u64) -> u64 {
-    let whole = udiv(g, r2);
-    let rest = g - whole * r2;
-    let cut = (64 - r2.leading_zeros()).saturating_sub(35);
-    let part = udiv((rest >> cut) * a, r2 >> cut);
-    whole.saturating_mul(a).saturating_add(part).min(SCALED_MAX)
+/// `floor(a / n)` for `a` below `2^31` and `n` from `2^15` to `2^16 - 1`
+/// (so the quotient is below `2^16`): the vortex's one division. On
+/// 32-bit Arm by shifting and subtracting, as
+/// [`udiv`](crate::rules::fixed::udiv) does, in 16 rounds with no test for
+/// their number, where the runtime's general routine is long (Armv6-M has
+/// no divide instruction).
+#[inline]
+fn share(a: u32, n: u32) -> u32 {
+    if cfg!(target_arch = "arm") { share_by_rounds(a, n) } else { a / n }
+}
+
+/// [`share`] by shift and subtract (tested against `/`).
+fn share_by_rounds(a: u32, n: u32) -> u32 {
+    let (mut rest, mut d, mut q) = (a, n << 15, 0);
+    for _ in 0..16 {
+        q <<= 1;
+        if rest >= d {
+            rest -= d;
+            q |= 1;
+        }
+        d >>= 1;
+    }
+    q
 }
 
 #[cfg(test)]
 mod tests {
+    extern crate std;
+
     use super::*;
+
+    #[test]
+    fn the_share_by_rounds_divides() {
+        // Expect: the quotient for every divisor, with dividends at both
+        // ends of their range and between.
+        let mut rng = crate::rules::rng::block_stream(43, 0, 0);
+        for n in 1 << 15..1 << 16 {
+            for a in [0, 1, n - 1, n, (1 << 31) - 1, rng.bits(31), rng.bits(31)] {
+                assert_eq!(share_by_rounds(a, n), a / n, "{a} / {n}");
+            }
+        }
+    }
 
     #[test]
     fn rankine_profile() {
@@ -212,18 +273,46 @@ mod tests {
     }
 
     #[test]
-    fn the_ratio_is_the_quotient() {
-        // Expect: floor(g a / r2) computed in 128 bits, to a unit (the
-        // cut remainder), saturated at 2^59.
+    fn the_push_is_the_quotient_to_its_bound() {
+        // Expect: each component of the push within M1c's bound of
+        // G d / max(|d|^2, R^2) computed exactly in 128 bits (G the
+        // strength before its cut to 16 bits): 2^-11 of
+        // |G| max(|dx|, |dy|, R) / max(|d|^2, R^2), plus a unit; the
+        // sign antisymmetric; saturation at 2^59. Offsets from 0 to 2^28
+        // and strengths from 1 to 2^59, each of a random bit length.
         let mut rng = crate::rules::rng::block_stream(41, 0, 0);
+        let mut worst = 0f64;
         for _ in 0..crate::sized(20_000, 500) {
-            let g = rng.next_u64() >> (3 + rng.bits(6) % 60);
-            let a = u64::from(rng.bits(28));
-            let r2 = (rng.next_u64() >> (7 + rng.bits(6) % 57)).max(1);
-            let want = (u128::from(g) * u128::from(a) / u128::from(r2)).min(1 << 59) as u64;
-            let got = ratio(g, a, r2);
-            assert!(got.abs_diff(want) <= 1, "{g} {a} {r2}: {got} vs {want}");
+            let mut length = |most: u32| {
+                let word = u64::from(rng.bits(32)) << 32 | u64::from(rng.bits(32));
+                let bits = rng.bits(8) % (most + 1);
+                if bits == 0 { 0 } else { word >> (64 - bits) }
+            };
+            let strength = length(59) as i64 * if length(1) == 0 { 1 } else { -1 };
+            let core = length(28) as i64;
+            let centre = [length(28) as i64, length(28) as i64];
+            let v = Swirl { centre, core: core as u32, strength: 0.0 };
+            let pos = [length(20) as usize, length(20) as usize, 0];
+            let got = v.at(pos, Strength::of(strength));
+            let d = [0, 1].map(|a| (((pos[a] as i64) << 8) + 128 - centre[a]).clamp(-REACH, REACH) as i128);
+            let r2 = (d[0] * d[0] + d[1] * d[1]).max(i128::from(core) * i128::from(core));
+            if r2 == 0 {
+                assert_eq!(got, [0, 0]);
+                continue;
+            }
+            let g = i128::from(strength);
+            let big = d[0].abs().max(d[1].abs()).max(i128::from(core));
+            let bound = (g.abs() * big) as f64 / r2 as f64 / 2048.0 + 1.0;
+            for (k, want) in [-g * d[1] / r2, g * d[0] / r2].into_iter().enumerate() {
+                let want = want.clamp(-(1 << 59), 1 << 59);
+                let off = (i128::from(got[k]) - want).abs() as f64;
+                assert!(off <= bound, "{strength} {core} {centre:?} {pos:?}: {got:?}, want {want}");
+                if want.abs() < 1 << 59 {
+                    worst = worst.max((off - 1.0) / (bound - 1.0));
+                }
+            }
         }
+        std::println!("worst error {worst:.3} of the bound");
     }
 
     #[test]

@@ -51,7 +51,7 @@ mod tests {
         // left as it is.
         let mut rng = block_stream(31, 0, 0);
         let unit = 127 << 16;
-        let class = Class { push: 0.0, relative: 1 << 24, energy: 1.0, swirl: 0, spare: 0 };
+        let class = Class { push: 0.0, relative: 1 << 24, energy: 1.0, swirl: Default::default(), spare: 0 };
         for i in 0..crate::sized(20_000, 500) {
             let big = (rng.bits(27) as i32) >> (rng.bits(4) % 6);
             let mut x0 = [0, 1, 2].map(|_| (rng.bits(27) as i32 - (1 << 26)) % (big + 1));

@@ -29,7 +29,7 @@ pub(crate) mod rounding;
 pub(crate) mod tasks;
 
 use crate::rules::fixed::{divr, magnitude, quot, scaled, scaled_by, to_fine, unit_scale};
-use crate::rules::force::{Flow, ForceTerms, Swirl};
+use crate::rules::force::{Flow, ForceTerms, Strength, Swirl};
 use crate::rules::quant::Quant;
 use crate::rules::rng::StepKey;
 use crate::rules::class::Class;
@@ -326,7 +326,7 @@ fn convert_class(m: (u32, i32), largest: (u32, i32), dt: f32, (s, fine): (u32, i
         relative: (scaled(quot(m, largest, 0), 1.0, 24) as u32).max(1),
         energy: quot(magnitude(quot(m, (s, 0), 0)), (s, 0), 31 - 2 * fine),
         spare: 0,
-        swirl: swirl.map_or(0, |v| v.gamma(push, (s, fine))),
+        swirl: swirl.map_or(Strength::default(), |v| v.gamma(push, (s, fine))),
     }
 }
 
