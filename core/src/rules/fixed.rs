@@ -1,8 +1,9 @@
 //! The step's integer arithmetic (M1c): working velocities in fine units,
-//! the few operations that need more than 32 bits, the exact conversion of
-//! a float setting to an integer, and the table of turns that the 2D
-//! collision reads. Every function here gives the same integer on every
-//! target; none computes in floating point.
+//! the few operations that need more than 32 bits, the vortex's one 32-bit
+//! division, the exact conversion of a float setting to an integer, and
+//! the table of turns that the 2D collision reads. Every function here
+//! gives the same integer on every target; none computes in floating
+//! point.
 
 /// The bound a stage saturates a working component to (M1c): at least
 /// eight unit speeds at either width, far above anything but an absurd
@@ -89,9 +90,14 @@ pub(crate) fn isqrt(n: u64) -> u64 {
 /// lands at or above the root's floor, and the rounds after it decrease to
 /// it, which they have reached once the square is at most `n`. A caller
 /// that knows the root is near a value (the clamp, M5.5: near the unit
-/// speed) passes it.
+/// speed) passes it. On 32-bit Arm, whose cores divide 64 bits only by
+/// shifting and subtracting (each round of Newton's a long division), digit
+/// by digit instead, without the guess.
 #[inline(never)]
 pub(crate) fn isqrt_from(n: u64, guess: u64) -> u64 {
+    if cfg!(target_arch = "arm") {
+        return isqrt_by_digits(n);
+    }
     if n < 2 {
         return n;
     }
@@ -102,6 +108,26 @@ pub(crate) fn isqrt_from(n: u64, guess: u64) -> u64 {
         x = (x + udiv(n, x)) / 2;
     }
     x
+}
+
+/// `floor(sqrt(n))` digit by digit, one result bit a round from the
+/// highest power of four at most `n`: 64-bit shifts, adds and compares, no
+/// division (tested against Newton's iteration).
+fn isqrt_by_digits(n: u64) -> u64 {
+    if n == 0 {
+        return 0;
+    }
+    let (mut rest, mut root, mut bit) = (n, 0u64, 1u64 << ((63 - n.leading_zeros()) & !1));
+    while bit != 0 {
+        if rest >= root + bit {
+            rest -= root + bit;
+            root = (root >> 1) + bit;
+        } else {
+            root >>= 1;
+        }
+        bit >>= 2;
+    }
+    root
 }
 
 /// `sqrt(n)` rounded to the nearest integer: where a length multiplies a
@@ -128,14 +154,55 @@ pub(crate) fn csqrt(n: u64, guess: u64) -> u64 {
 /// `floor(2^32 unit / L)`, shifted down by 32 and rounded down, with `L`
 /// the length rounded up, so the result is never longer than `unit`.
 pub(crate) fn shorten(mut x: [i32; 3], s2: u64, unit: i32, dim: usize) -> [i32; 3] {
-    // L > unit, so the factor is below 2^32, and a component (below 2^30)
-    // times it fits 64 bits.
-    let factor = udiv((unit as u64) << 32, csqrt(s2, unit as u64));
+    // L > unit, so the factor is below 2^32, and a component (at most
+    // 2^30) times it fits 64 bits; L is below 2^31 (three such components).
+    let length = csqrt(s2, unit as u64);
+    let factor = if cfg!(target_arch = "arm") { u64::from(fraction(unit as u32, length as u32)) } else { udiv((unit as u64) << 32, length) };
     for c in x.iter_mut().take(dim) {
         let scaled = ((u64::from(c.unsigned_abs()) * factor) >> 32) as i32;
         *c = if *c < 0 { -scaled } else { scaled };
     }
     x
+}
+
+/// `floor(a / n)` where the quotient is below `2^16` and `n` below `2^17`:
+/// the vortex's one division (M1c). On 32-bit Arm by shifting and
+/// subtracting, as [`udiv`] does, in 16 rounds with no test for their
+/// number, where the runtime's general routine is long (Armv6-M has no
+/// divide instruction); elsewhere the instruction.
+#[inline]
+pub(crate) fn quotient16(a: u32, n: u32) -> u32 {
+    if cfg!(target_arch = "arm") { quotient16_by_rounds(a, n) } else { a / n }
+}
+
+/// [`quotient16`] by shift and subtract (tested against `/`).
+fn quotient16_by_rounds(a: u32, n: u32) -> u32 {
+    let (mut rest, mut d, mut q) = (a, n << 15, 0);
+    for _ in 0..16 {
+        q <<= 1;
+        if rest >= d {
+            rest -= d;
+            q |= 1;
+        }
+        d >>= 1;
+    }
+    q
+}
+
+/// `floor(2^32 a / b)` for `a < b` below `2^31`, one quotient bit a round
+/// with a remainder that stays below `2b`, so in 32 bits: the clamp's
+/// factor where 64-bit division is shift and subtract (tested against it).
+fn fraction(a: u32, b: u32) -> u32 {
+    let (mut rest, mut q) = (a, 0u32);
+    for _ in 0..32 {
+        rest <<= 1;
+        q <<= 1;
+        if rest >= b {
+            rest -= b;
+            q |= 1;
+        }
+    }
+    q
 }
 
 /// `x` clamped to `unit` ([`shorten`] where it is longer), uncounted.
@@ -358,6 +425,7 @@ mod tests {
             assert!((near as f64 - (n as f64).sqrt()).abs() <= 0.5 + 1e-9, "{n}: {near}");
             let up = csqrt(n, 1 + n % 1000);
             assert_eq!(isqrt_from(n, 1 + n % 77), r);
+            assert_eq!(isqrt_by_digits(n), r);
             assert!(up * up >= n && (up == 0 || (up - 1) * (up - 1) < n), "{n}: {up}");
         };
         for n in 0..10_000 {
@@ -371,6 +439,33 @@ mod tests {
         let mut rng = block_stream(21, 0, 0);
         for _ in 0..crate::sized(100_000, 2_000) {
             check(rng.next_u64() >> (8 + rng.bits(6) % 48));
+        }
+    }
+
+    #[test]
+    fn fraction_is_the_quotient() {
+        // Expect: floor(2^32 a / b) for a < b, at the ends of the range and
+        // at random.
+        let mut rng = block_stream(47, 0, 0);
+        for _ in 0..crate::sized(100_000, 2_000) {
+            let b = (rng.bits(31) >> rng.bits(5)).max(1);
+            for a in [0, b - 1, rng.bits(32) % b] {
+                assert_eq!(u64::from(fraction(a, b)), (u64::from(a) << 32) / u64::from(b), "{a} / {b}");
+            }
+        }
+    }
+
+    #[test]
+    fn quotient16_by_rounds_divides() {
+        // Expect: the quotient for every divisor from 2^14 to 2^16, with
+        // dividends at both ends of their range (a quotient below 2^16)
+        // and between.
+        let mut rng = block_stream(43, 0, 0);
+        for n in 1 << 14..=1 << 16 {
+            let most = (u64::from(n) << 16).min(1 << 32) - 1;
+            for a in [0, 1, n - 1, n, most as u32, rng.bits(32) % (most as u32), rng.bits(31) % (most as u32)] {
+                assert_eq!(quotient16_by_rounds(a, n), a / n, "{a} / {n}");
+            }
         }
     }
 

@@ -6,7 +6,7 @@
 //! velocities towards (M5.1b).
 
 use crate::api::desc::Vortex;
-use crate::rules::fixed::{magnitude, quot, sat, scaled, scaled_by, to_fine, SCALED_MAX};
+use crate::rules::fixed::{magnitude, quot, quotient16, sat, scaled, scaled_by, to_fine, SCALED_MAX};
 use crate::rules::class::Class;
 
 /// The force terms of one step, read-only, for the general force path.
@@ -203,7 +203,7 @@ impl Swirl {
         let n = (ax * ax + ay * ay).max(core * core);
         let b = 32 - n.leading_zeros() as i32;
         let top = if b > 16 { n >> (b - 16) } else { n << (16 - b) };
-        let f = share(gamma.g.unsigned_abs() << 15, top);
+        let f = quotient16(gamma.g.unsigned_abs() << 15, top);
         let e = gamma.e - cut as i32 - b + 1;
         let signed = |a: u32, negative: bool| {
             let y = u64::from(f * a);
@@ -214,48 +214,11 @@ impl Swirl {
     }
 }
 
-/// `floor(a / n)` for `a` below `2^31` and `n` from `2^15` to `2^16 - 1`
-/// (so the quotient is below `2^16`): the vortex's one division. On
-/// 32-bit Arm by shifting and subtracting, as
-/// [`udiv`](crate::rules::fixed::udiv) does, in 16 rounds with no test for
-/// their number, where the runtime's general routine is long (Armv6-M has
-/// no divide instruction).
-#[inline]
-fn share(a: u32, n: u32) -> u32 {
-    if cfg!(target_arch = "arm") { share_by_rounds(a, n) } else { a / n }
-}
-
-/// [`share`] by shift and subtract (tested against `/`).
-fn share_by_rounds(a: u32, n: u32) -> u32 {
-    let (mut rest, mut d, mut q) = (a, n << 15, 0);
-    for _ in 0..16 {
-        q <<= 1;
-        if rest >= d {
-            rest -= d;
-            q |= 1;
-        }
-        d >>= 1;
-    }
-    q
-}
-
 #[cfg(test)]
 mod tests {
     extern crate std;
 
     use super::*;
-
-    #[test]
-    fn the_share_by_rounds_divides() {
-        // Expect: the quotient for every divisor, with dividends at both
-        // ends of their range and between.
-        let mut rng = crate::rules::rng::block_stream(43, 0, 0);
-        for n in 1 << 15..1 << 16 {
-            for a in [0, 1, n - 1, n, (1 << 31) - 1, rng.bits(31), rng.bits(31)] {
-                assert_eq!(share_by_rounds(a, n), a / n, "{a} / {n}");
-            }
-        }
-    }
 
     #[test]
     fn rankine_profile() {
