@@ -308,8 +308,9 @@ impl Description {
     /// Every check of a description but its memory plan, in the order
     /// they are made ([`Description::validate`] adds the plan): dimension,
     /// sizes and faces (M1, M4), then masses, restitutions, `dt` and every
-    /// force parameter, then the parts this build leaves out.
-    pub(crate) fn check(&self) -> Result<(), Error> {
+    /// force parameter, then the parts this build leaves out. What passes
+    /// is what a plan is made from.
+    pub(crate) fn check(&self) -> Result<Checked<'_>, Error> {
         let dim = self.dim as usize;
         if dim != 2 && dim != 3 {
             return Err(Error::BadDimension);
@@ -379,7 +380,7 @@ impl Description {
         if self.per_particle_mass && !(1..=256).contains(&self.mass_classes) {
             return Err(Error::CapacityRange);
         }
-        Ok(())
+        Ok(Checked(self))
     }
 
     /// `per_particle_mass`, false by construction in a build without the
@@ -451,6 +452,20 @@ impl Description {
     #[inline(always)]
     pub(crate) const fn has_energy_neutral(&self) -> bool {
         cfg!(feature = "collision-rules") && self.energy_neutral
+    }
+}
+
+/// A description that passed [`Description::check`]: what a memory plan
+/// ([`Layout::of`](crate::storage::layout::Layout::of)) is made from, so
+/// that no plan is made of a description nobody checked.
+#[derive(Clone, Copy)]
+pub(crate) struct Checked<'a>(&'a Description);
+
+impl core::ops::Deref for Checked<'_> {
+    type Target = Description;
+
+    fn deref(&self) -> &Description {
+        self.0
     }
 }
 

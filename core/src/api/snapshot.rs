@@ -499,7 +499,7 @@ fn read(image: &[u8]) -> Result<Image<'_>, Error> {
         return Err(bad);
     }
     let desc = get_desc(&mut g)?;
-    let layout = Layout::of(&desc).map_err(|e| match e {
+    let layout = desc.plan().map_err(|e| match e {
         Error::Dim3Disabled | Error::Q16Disabled | Error::FeatureDisabled | Error::TooLarge => e,
         _ => bad,
     })?;

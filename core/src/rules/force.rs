@@ -33,7 +33,7 @@ impl ForceTerms<'_> {
         let k = class.push;
         let mut p = self.gravity;
         // Without the feature `fields` a world has neither term
-        // (`Layout::of`), and the build no code for them.
+        // (`Description::check`), and the build no code for them.
         if cfg!(feature = "fields") {
             if let Some(field) = self.field {
                 for a in 0..self.dim {

@@ -24,7 +24,7 @@ macro_rules! with_quant {
                 $body
             }
             #[cfg(not(feature = "q16"))]
-            $crate::api::desc::Quantization::Bits16 => unreachable!("refused by Layout::of"),
+            $crate::api::desc::Quantization::Bits16 => unreachable!("refused by Description::check"),
         }
     };
 }

@@ -7,7 +7,7 @@
 use core::mem::{align_of, size_of};
 
 use crate::Error;
-use crate::api::desc::{Description, Quantization};
+use crate::api::desc::{Checked, Description, Quantization};
 use crate::rules::emitter::Slot;
 use crate::rules::obstacle::Surface;
 use crate::rules::class::Class;
@@ -184,11 +184,10 @@ impl Layout {
 }
 
 impl Layout {
-    /// Checks `d` ([`Description::check`]) and plans its memory. Every
-    /// size computation is checked, so a description whose byte count would
-    /// overflow is refused.
-    pub fn of(d: &Description) -> Result<Layout, Error> {
-        d.check()?;
+    /// Plans the memory of a checked description ([`Description::check`]).
+    /// Every size computation is checked, so a description whose byte
+    /// count would overflow is refused.
+    pub fn of(d: Checked<'_>) -> Result<Layout, Error> {
         let dim = d.dim as usize;
         let mut n = [1usize; 3];
         for k in 0..dim {
@@ -258,7 +257,16 @@ impl Description {
     /// too large for the target is refused); the first problem found is
     /// returned.
     pub fn validate(&self) -> Result<(), Error> {
-        Layout::of(self).map(|_| ())
+        self.plan().map(|_| ())
+    }
+
+    /// The checks ([`Description::check`]) and then the memory plan
+    /// ([`Layout::of`]): what every caller that builds, sizes or loads a
+    /// world needs. Out of line, so that the checks exist once in the
+    /// build.
+    #[inline(never)]
+    pub(crate) fn plan(&self) -> Result<Layout, Error> {
+        Layout::of(self.check()?)
     }
 }
 

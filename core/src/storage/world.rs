@@ -98,7 +98,7 @@ pub struct World {
 
 /// Bytes a world built from `desc` needs, alignment slack included.
 pub fn world_bytes(desc: &Description) -> Result<usize, Error> {
-    let layout = Layout::of(desc)?;
+    let layout = desc.plan()?;
     (align_of::<Header>() - 1 + size_of::<Header>()).checked_add(layout.total).ok_or(Error::TooLarge)
 }
 
@@ -113,7 +113,7 @@ impl World {
     pub fn init<'a>(desc: &Description, memory: &'a mut [u8]) -> Result<&'a mut World, Error> {
         // Read inside the result: moved out, the layout would be copied
         // once more before its copy into the header.
-        let layout = Layout::of(desc);
+        let layout = desc.plan();
         let layout = layout.as_ref().map_err(|&e| e)?;
         let pad = (memory.as_ptr() as usize).wrapping_neg() & (WORLD_ALIGN - 1);
         let need = pad.checked_add(size_of::<Header>()).and_then(|n| n.checked_add(layout.total)).ok_or(Error::TooLarge)?;
@@ -278,7 +278,7 @@ impl World {
             mine
         };
         // A plane of a part the build leaves out is empty in every layout
-        // (`Layout::of` refuses a description that would need it): no
+        // (`Description::check` refuses a description that would need it): no
         // split, and no code, for it; an empty slice of its own type
         // stands for it.
         let (obstacles, mass, fields) = (cfg!(feature = "obstacles"), cfg!(feature = "mass"), cfg!(feature = "fields"));
