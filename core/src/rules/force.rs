@@ -240,9 +240,9 @@ mod tests {
         // Expect: each component of the push within M1c's bound of
         // G d / max(|d|^2, R^2) computed exactly in 128 bits (G the
         // strength before its cut to 16 bits): 2^-11 of
-        // |G| max(|dx|, |dy|, R) / max(|d|^2, R^2), plus a unit; the
-        // sign antisymmetric; saturation at 2^59. Offsets from 0 to 2^28
-        // and strengths from 1 to 2^59, each of a random bit length.
+        // |G| max(|dx|, |dy|, R) / max(|d|^2, R^2), plus a unit, with
+        // saturation at 2^59. Offsets from 0 to 2^28 and strengths from 1
+        // to 2^59, each of a random bit length.
         let mut rng = crate::rules::rng::block_stream(41, 0, 0);
         let mut worst = 0f64;
         for _ in 0..crate::sized(20_000, 500) {
