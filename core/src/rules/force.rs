@@ -189,7 +189,8 @@ impl Swirl {
     /// to 15 bits and the squared length to its top 16, so that every
     /// product and the one division fit 32 bits (a GPU has no wider
     /// integers, a small core no 64-bit divide).
-    #[inline]
+    #[cfg_attr(feature = "small-step", inline)]
+    #[cfg_attr(not(feature = "small-step"), inline(always))]
     pub(crate) fn at(&self, pos: [usize; 3], gamma: Strength) -> [i64; 2] {
         let d = |a: usize| (((pos[a] as i64) << 8) + 128 - self.centre[a]).clamp(-REACH, REACH);
         let (dx, dy) = (d(0), d(1));
