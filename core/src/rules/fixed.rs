@@ -177,30 +177,28 @@ pub(crate) fn quotient16(a: u32, n: u32) -> u32 {
 
 /// [`quotient16`] by shift and subtract (tested against `/`).
 fn quotient16_by_rounds(a: u32, n: u32) -> u32 {
-    let (mut rest, mut d, mut q) = (a, n << 15, 0);
-    for _ in 0..16 {
+    long_division(a, n << 15, 16)
+}
+
+/// `floor(2^32 a / b)` for `a < b` below `2^31`: the clamp's factor where
+/// 64-bit division is shift and subtract (tested against it).
+fn fraction(a: u32, b: u32) -> u32 {
+    long_division(a << 1, b, 32)
+}
+
+/// `floor(rest 2^(rounds - 1) / d)` for `rest < 2d` and `d` at most
+/// `2^31`, one quotient bit a round: the remainder stays below `2d`, so
+/// in 32 bits. The shift and subtract of [`quotient16`] and of the
+/// clamp's factor.
+fn long_division(mut rest: u32, d: u32, rounds: u32) -> u32 {
+    let mut q = 0;
+    for _ in 0..rounds {
         q <<= 1;
         if rest >= d {
             rest -= d;
             q |= 1;
         }
-        d >>= 1;
-    }
-    q
-}
-
-/// `floor(2^32 a / b)` for `a < b` below `2^31`, one quotient bit a round
-/// with a remainder that stays below `2b`, so in 32 bits: the clamp's
-/// factor where 64-bit division is shift and subtract (tested against it).
-fn fraction(a: u32, b: u32) -> u32 {
-    let (mut rest, mut q) = (a, 0u32);
-    for _ in 0..32 {
         rest <<= 1;
-        q <<= 1;
-        if rest >= b {
-            rest -= b;
-            q |= 1;
-        }
     }
     q
 }
