@@ -532,6 +532,41 @@ typedef uint32_t mpca_cell_kind;
 #endif // __cplusplus
 
 /**
+ * Values of `mpca_shape.kind` (M7).
+ */
+enum mpca_shape_kind
+#if defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+  : uint32_t
+#endif // defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+ {
+  /**
+   * Every cell on the far side of the plane through `a` with outward
+   * normal `b` (as mpca_world_add_half_space).
+   */
+  MPCA_SHAPE_KIND_HALF_SPACE = 0,
+  /**
+   * Every cell whose centre lies in the box `a <= c <= b` (as
+   * mpca_world_add_box).
+   */
+  MPCA_SHAPE_KIND_BOX = 1,
+  /**
+   * A disc of centre `a` (x and y) and radius `radius`, 2D worlds only.
+   */
+  MPCA_SHAPE_KIND_DISC = 2,
+  /**
+   * A sphere of centre `a` and radius `radius`, 3D worlds only.
+   */
+  MPCA_SHAPE_KIND_SPHERE = 3,
+};
+#ifndef __cplusplus
+#if __STDC_VERSION__ >= 202311L
+typedef enum mpca_shape_kind mpca_shape_kind;
+#else
+typedef uint32_t mpca_shape_kind;
+#endif // __STDC_VERSION__ >= 202311L
+#endif // __cplusplus
+
+/**
  * An opaque world, reached through its handle: the `mpca_world *` that
  * mpca_world_create or mpca_world_init wrote. A handle is only ever passed
  * back to this library, never dereferenced. (Not `repr(C)`, so cbindgen
@@ -772,6 +807,36 @@ typedef struct mpca_emitter {
    */
   uint32_t lifetime;
 } mpca_emitter;
+
+/**
+ * An obstacle shape (M7) as one value: to ask what it takes
+ * (mpca_desc_surface_entries, mpca_world_surface_entries) and to add it
+ * (mpca_world_add_shape). Set `struct_size` to `sizeof(mpca_shape)`.
+ */
+typedef struct mpca_shape {
+  /**
+   * `sizeof(mpca_shape)`.
+   */
+  uint32_t struct_size;
+  /**
+   * An `mpca_shape_kind`.
+   */
+  uint32_t kind;
+  /**
+   * A point on the plane (half-space), the lower corner (box), the
+   * centre (disc, sphere).
+   */
+  float a[3];
+  /**
+   * The outward normal (half-space), the upper corner (box); not read
+   * for a disc or a sphere.
+   */
+  float b[3];
+  /**
+   * The radius (disc, sphere); not read for the others.
+   */
+  float radius;
+} mpca_shape;
 
 /**
  * The host's parallel-for, called once per step by
@@ -1093,6 +1158,35 @@ mpca_status mpca_world_set_wind_field(struct mpca_world *world, const float *win
 mpca_status mpca_world_set_cell_wind(struct mpca_world *world,
                                      const uint32_t *pos,
                                      const float *wind);
+
+/**
+ * The surface entries `shape` takes as the first obstacle of a world of
+ * `desc`, into `out_entries`: the `surface_capacity` it needs, asked before
+ * the world is made. A world of several shapes needs at most the sum of
+ * theirs. Refused as mpca_world_bytes would refuse the description and
+ * mpca_world_add_shape the shape; MPCA_STATUS_NOT_ENABLED where
+ * `desc.obstacles` is 0.
+ */
+mpca_status mpca_desc_surface_entries(const struct mpca_desc *desc,
+                                      const struct mpca_shape *shape,
+                                      uint32_t *out_entries);
+
+/**
+ * The surface entries adding `shape` to `world` now takes, into
+ * `out_entries`: what its table must have free for mpca_world_add_shape
+ * to succeed. Refused as mpca_world_add_shape would refuse the shape.
+ */
+mpca_status mpca_world_surface_entries(const struct mpca_world *world,
+                                       const struct mpca_shape *shape,
+                                       uint32_t *out_entries);
+
+/**
+ * Adds `shape`'s cells as obstacles of restitution `e`, with normals from
+ * its exact geometry: the same as the call for its kind
+ * (mpca_world_add_half_space, mpca_world_add_box, mpca_world_add_disc,
+ * mpca_world_add_sphere).
+ */
+mpca_status mpca_world_add_shape(struct mpca_world *world, const struct mpca_shape *shape, float e);
 
 /**
  * Makes the cell at `pos` an obstacle with outward `normal` (3 values,

@@ -94,6 +94,15 @@ inline std::size_t world_bytes(const mpca_desc &desc) {
     return bytes;
 }
 
+/** The surface entries `shape` takes as the first obstacle of a world of
+ * `desc` (mpca_desc_surface_entries); sets the shape's struct_size. */
+inline std::uint32_t surface_entries(const mpca_desc &desc, mpca_shape shape) {
+    shape.struct_size = sizeof shape;
+    std::uint32_t entries = 0;
+    check(mpca_desc_surface_entries(&desc, &shape, &entries));
+    return entries;
+}
+
 /** The description of the world a snapshot image holds (mpca_desc_from_image). */
 inline mpca_desc desc_from_image(const void *image, std::size_t len) {
     mpca_desc d = mpca_desc();
@@ -497,6 +506,22 @@ public:
     /** Obstacle cells beyond the plane through `point` with outward `normal`. */
     void add_half_space(const vec3 &point, const vec3 &normal, float e) {
         check(mpca_world_add_half_space(w_, point.data(), normal.data(), e));
+    }
+
+    /** The surface entries adding `shape` now takes
+     * (mpca_world_surface_entries); sets the shape's struct_size. */
+    std::uint32_t surface_entries(mpca_shape shape) const {
+        shape.struct_size = sizeof shape;
+        std::uint32_t entries = 0;
+        check(mpca_world_surface_entries(w_, &shape, &entries));
+        return entries;
+    }
+
+    /** Adds `shape`'s cells as obstacles (mpca_world_add_shape); sets its
+     * struct_size. */
+    void add_shape(mpca_shape shape, float e) {
+        shape.struct_size = sizeof shape;
+        check(mpca_world_add_shape(w_, &shape, e));
     }
 
     /** Adds an emitter and returns its index; sets its struct_size. */

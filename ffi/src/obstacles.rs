@@ -1,9 +1,108 @@
 //! Obstacles (M7): single cells, shapes with exact normals, and masks.
-//! Each call adds all of its cells or, refused, none.
+//! Each call adds all of its cells or, refused, none. The surface entries
+//! a shape takes can be asked first, of a description or of a world.
 
 use mpca_core::Shape;
 
-use crate::{guard, mpca_status, mpca_world};
+use crate::desc::mpca_desc;
+use crate::{check_size, guard, mpca_status, mpca_world};
+
+/// Values of `mpca_shape.kind` (M7).
+#[repr(u32)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum mpca_shape_kind {
+    /// Every cell on the far side of the plane through `a` with outward
+    /// normal `b` (as mpca_world_add_half_space).
+    HalfSpace = 0,
+    /// Every cell whose centre lies in the box `a <= c <= b` (as
+    /// mpca_world_add_box).
+    Box = 1,
+    /// A disc of centre `a` (x and y) and radius `radius`, 2D worlds only.
+    Disc = 2,
+    /// A sphere of centre `a` and radius `radius`, 3D worlds only.
+    Sphere = 3,
+}
+
+/// An obstacle shape (M7) as one value: to ask what it takes
+/// (mpca_desc_surface_entries, mpca_world_surface_entries) and to add it
+/// (mpca_world_add_shape). Set `struct_size` to `sizeof(mpca_shape)`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct mpca_shape {
+    /// `sizeof(mpca_shape)`.
+    pub struct_size: u32,
+    /// An `mpca_shape_kind`.
+    pub kind: u32,
+    /// A point on the plane (half-space), the lower corner (box), the
+    /// centre (disc, sphere).
+    pub a: [f32; 3],
+    /// The outward normal (half-space), the upper corner (box); not read
+    /// for a disc or a sphere.
+    pub b: [f32; 3],
+    /// The radius (disc, sphere); not read for the others.
+    pub radius: f32,
+}
+
+impl mpca_shape {
+    /// The core's shape; a wrong `struct_size` or an unknown kind is
+    /// refused here, the geometry by the core.
+    fn to_core(self) -> Result<Shape, mpca_status> {
+        check_size::<mpca_shape>(self.struct_size)?;
+        let (a, b, radius) = (self.a, self.b, self.radius);
+        Ok(match self.kind {
+            0 => Shape::HalfSpace { point: a, normal: b },
+            1 => Shape::Box { min: a, max: b },
+            2 => Shape::Disc { centre: [a[0], a[1]], radius },
+            3 => Shape::Sphere { centre: a, radius },
+            _ => return Err(mpca_status::BadEnum),
+        })
+    }
+}
+
+/// The surface entries `shape` takes as the first obstacle of a world of
+/// `desc`, into `out_entries`: the `surface_capacity` it needs, asked before
+/// the world is made. A world of several shapes needs at most the sum of
+/// theirs. Refused as mpca_world_bytes would refuse the description and
+/// mpca_world_add_shape the shape; MPCA_STATUS_NOT_ENABLED where
+/// `desc.obstacles` is 0.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mpca_desc_surface_entries(desc: *const mpca_desc, shape: *const mpca_shape, out_entries: *mut u32) -> mpca_status {
+    guard(|c| {
+        let d = c.get(desc)?.to_core();
+        let d = d.as_ref().map_err(|&s| s)?;
+        let shape = c.get(shape)?.to_core()?;
+        let out = c.out(out_entries)?;
+        out.set(d.surface_entries(shape)?);
+        Ok(())
+    })
+}
+
+/// The surface entries adding `shape` to `world` now takes, into
+/// `out_entries`: what its table must have free for mpca_world_add_shape
+/// to succeed. Refused as mpca_world_add_shape would refuse the shape.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mpca_world_surface_entries(world: *const mpca_world, shape: *const mpca_shape, out_entries: *mut u32) -> mpca_status {
+    guard(|c| {
+        let w = c.world_ref(world)?;
+        let shape = c.get(shape)?.to_core()?;
+        let out = c.out(out_entries)?;
+        out.set(w.surface_entries(shape)?);
+        Ok(())
+    })
+}
+
+/// Adds `shape`'s cells as obstacles of restitution `e`, with normals from
+/// its exact geometry: the same as the call for its kind
+/// (mpca_world_add_half_space, mpca_world_add_box, mpca_world_add_disc,
+/// mpca_world_add_sphere).
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mpca_world_add_shape(world: *mut mpca_world, shape: *const mpca_shape, e: f32) -> mpca_status {
+    guard(|c| {
+        let w = c.world(world)?;
+        let shape = c.get(shape)?.to_core()?;
+        Ok(w.add_shape(shape, e)?)
+    })
+}
 
 /// Makes the cell at `pos` an obstacle with outward `normal` (3 values,
 /// normalised by the library) and restitution `e`.

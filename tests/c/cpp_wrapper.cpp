@@ -296,8 +296,23 @@ static void same_as_c() {
     mpca_desc d3 = mpca::desc_3d(16, 16, 16);
     d3.obstacles = 1;
     d3.surface_capacity = 512;
+    /* A sphere sized before its world is made: the description's count
+     * is the world's, and the shape's wrapper adds what add_sphere adds. */
+    mpca_shape ball = mpca_shape();
+    ball.kind = MPCA_SHAPE_KIND_SPHERE;
+    ball.a[0] = ball.a[1] = ball.a[2] = 8.0f;
+    ball.radius = 3.0f;
+    const std::uint32_t entries = mpca::surface_entries(d3, ball);
+    CHECK(entries > 0 && entries <= 512);
     mpca::world s(d3);
+    CHECK(s.surface_entries(ball) == entries);
     s.add_sphere({8.0f, 8.0f, 8.0f}, 3.0f, 1.0f);
+    CHECK(s.surface_entries(ball) == 0);
+    ball.a[0] = 12.0f; /* overlapping: only the cells not yet covered */
+    CHECK(s.surface_entries(ball) < entries);
+    s.add_shape(ball, 1.0f);
+    ball.kind = 9;
+    THROWS(MPCA_STATUS_BAD_ENUM, s.add_shape(ball, 1.0f));
     CHECK(s.cell({8, 8, 8}).kind == MPCA_CELL_KIND_OBSTACLE && std::strcmp(mpca::version(), mpca_version()) == 0);
 
     /* The wind plane (M5.1b): a particle at rest in a wind of (0.5, 0)
@@ -586,6 +601,9 @@ static void every_function() {
     WRAPS(mpca_world_add_obstacle, &W::add_obstacle);
     WRAPS(mpca_world_add_obstacle_mask, &W::add_obstacle_mask);
     WRAPS(mpca_world_surface, &W::surface);
+    WRAPS(mpca_world_surface_entries, &W::surface_entries);
+    WRAPS(mpca_world_add_shape, &W::add_shape);
+    WRAPS(mpca_desc_surface_entries, &mpca::surface_entries);
     WRAPS(mpca_world_add_emitter, &W::add_emitter);
     WRAPS(mpca_world_set_emitter_rate, &W::set_emitter_rate);
     std::printf("cpp: every function\n");

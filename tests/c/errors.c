@@ -25,6 +25,7 @@ STATIC_ASSERT(sizeof(mpca_particle) == 44 && ALIGNOF(mpca_particle) == 4, "mpca_
 STATIC_ASSERT(sizeof(mpca_particle_columns) == 8 + 5 * sizeof(void *) && ALIGNOF(mpca_particle_columns) == ALIGNOF(void *), "mpca_particle_columns layout");
 STATIC_ASSERT(sizeof(mpca_cell) == 48 && ALIGNOF(mpca_cell) == 4, "mpca_cell layout");
 STATIC_ASSERT(sizeof(mpca_emitter) == 56 && ALIGNOF(mpca_emitter) == 4, "mpca_emitter layout");
+STATIC_ASSERT(sizeof(mpca_shape) == 36 && ALIGNOF(mpca_shape) == 4, "mpca_shape layout");
 STATIC_ASSERT(sizeof(mpca_status) == 4 && sizeof(mpca_boundary) == 4, "enum sizes");
 
 /* The three values no float input may hold. */
@@ -673,6 +674,15 @@ static void handle_cases(void) {
 
 /* --- NULL for every other pointer parameter ----------------------------- */
 
+/* A shape of `kind`, every number 0 but the ones the caller sets. */
+static mpca_shape shape_of(mpca_shape_kind kind) {
+    mpca_shape s;
+    memset(&s, 0, sizeof s);
+    s.struct_size = sizeof s;
+    s.kind = kind;
+    return s;
+}
+
 static void null_cases(void) {
     set_context("NULL arguments");
     mpca_world *w = full2;
@@ -707,6 +717,18 @@ static void null_cases(void) {
     REFUSED(MPCA_STATUS_NULL_POINTER, mpca_world_add_box(w, lo, NULL, 1.0f));
     REFUSED(MPCA_STATUS_NULL_POINTER, mpca_world_add_sphere(full3, NULL, 1.0f, 1.0f));
     REFUSED(MPCA_STATUS_NULL_POINTER, mpca_world_add_obstacle_mask(w, NULL, CELLS2, 1.0f));
+    mpca_shape shape = shape_of(MPCA_SHAPE_KIND_DISC);
+    shape.a[0] = shape.a[1] = 9.5f;
+    shape.radius = 0.5f;
+    mpca_desc d = full_desc(2, N2);
+    uint32_t entries = SENTINEL_U32;
+    REFUSED(MPCA_STATUS_NULL_POINTER, mpca_world_add_shape(w, NULL, 1.0f));
+    REFUSED(MPCA_STATUS_NULL_POINTER, mpca_world_surface_entries(w, NULL, &entries));
+    REFUSED(MPCA_STATUS_NULL_POINTER, mpca_world_surface_entries(w, &shape, NULL));
+    REFUSED(MPCA_STATUS_NULL_POINTER, mpca_desc_surface_entries(NULL, &shape, &entries));
+    REFUSED(MPCA_STATUS_NULL_POINTER, mpca_desc_surface_entries(&d, NULL, &entries));
+    REFUSED(MPCA_STATUS_NULL_POINTER, mpca_desc_surface_entries(&d, &shape, NULL));
+    CHECK(entries == SENTINEL_U32);
     REFUSED(MPCA_STATUS_NULL_POINTER, mpca_world_surface(w, NULL, normal, &e));
     REFUSED(MPCA_STATUS_NULL_POINTER, mpca_world_surface(w, surface, NULL, &e));
     REFUSED(MPCA_STATUS_NULL_POINTER, mpca_world_surface(w, surface, normal, NULL));
@@ -954,6 +976,80 @@ static void force_cases(void) {
     REFUSED(MPCA_STATUS_NOT_ENABLED, mpca_world_set_cell_wind(bare2, pos, g));
 }
 
+/* Shapes as one value (mpca_shape): the surface entries one takes, asked
+ * of a description and of a world, refused as adding it would be. */
+static void shape_cases(void) {
+    set_context("mpca_shape");
+    mpca_shape disc = shape_of(MPCA_SHAPE_KIND_DISC);
+    disc.a[0] = 9.5f;
+    disc.a[1] = 9.5f;
+    disc.radius = 1.5f;
+    mpca_desc d = full_desc(2, N2);
+    uint32_t entries = SENTINEL_U32, now = SENTINEL_U32;
+    CHECK_OK(mpca_desc_surface_entries(&d, &disc, &entries));
+    CHECK(entries > 0 && entries != SENTINEL_U32);
+    /* full2's obstacles are away from the disc: the same count. */
+    CHECK_OK(mpca_world_surface_entries(full2, &disc, &now));
+    CHECK(now == entries);
+    /* A world of exactly that capacity takes it; one entry fewer, not. */
+    mpca_world *w = NULL;
+    CHECK_OK(mpca_desc_defaults(&d, 2, N2, N2, 0));
+    d.obstacles = 1;
+    d.surface_capacity = entries - 1;
+    CHECK_OK(mpca_world_create(&d, &w));
+    REFUSED(MPCA_STATUS_SURFACE_TABLE_FULL, mpca_world_add_shape(w, &disc, 1.0f));
+    CHECK_OK(mpca_world_destroy(w));
+    d.surface_capacity = entries;
+    CHECK_OK(mpca_world_create(&d, &w));
+    CHECK_OK(mpca_world_add_shape(w, &disc, 1.0f));
+    /* The same disc again covers only obstacle cells: nothing new. */
+    CHECK_OK(mpca_world_surface_entries(w, &disc, &now));
+    CHECK(now == 0);
+    CHECK_OK(mpca_world_destroy(w));
+
+    mpca_shape bad = disc;
+    uint32_t out = SENTINEL_U32;
+    bad.kind = 4;
+    REFUSED(MPCA_STATUS_BAD_ENUM, mpca_desc_surface_entries(&d, &bad, &out));
+    REFUSED(MPCA_STATUS_BAD_ENUM, mpca_world_surface_entries(full2, &bad, &out));
+    REFUSED(MPCA_STATUS_BAD_ENUM, mpca_world_add_shape(full2, &bad, 1.0f));
+    bad = disc;
+    bad.struct_size = sizeof bad - 4;
+    REFUSED(MPCA_STATUS_BAD_STRUCT_SIZE, mpca_desc_surface_entries(&d, &bad, &out));
+    REFUSED(MPCA_STATUS_BAD_STRUCT_SIZE, mpca_world_add_shape(full2, &bad, 1.0f));
+    bad = disc;
+    bad.kind = MPCA_SHAPE_KIND_SPHERE;
+    REFUSED(MPCA_STATUS_BAD_DIMENSION, mpca_world_surface_entries(full2, &bad, &out));
+    REFUSED(MPCA_STATUS_BAD_DIMENSION, mpca_world_add_shape(full2, &bad, 1.0f));
+    bad = disc;
+    bad.radius = -1.0f;
+    REFUSED(MPCA_STATUS_BAD_SHAPE, mpca_desc_surface_entries(&d, &bad, &out));
+    bad.radius = NAN;
+    REFUSED(MPCA_STATUS_NOT_FINITE, mpca_world_add_shape(full2, &bad, 1.0f));
+    bad = disc;
+    bad.kind = MPCA_SHAPE_KIND_BOX;
+    bad.a[0] = 4.0f; /* the box (4, 8)..(4.9, 8.9) holds the particle at (4, 8) */
+    bad.a[1] = 8.0f;
+    bad.b[0] = 4.9f;
+    bad.b[1] = 8.9f;
+    bad.b[2] = 1.0f;
+    REFUSED(MPCA_STATUS_CELL_OCCUPIED, mpca_world_surface_entries(full2, &bad, &out));
+    REFUSED(MPCA_STATUS_CELL_OCCUPIED, mpca_world_add_shape(full2, &bad, 1.0f));
+    REFUSED(MPCA_STATUS_NOT_ENABLED, mpca_world_surface_entries(bare2, &disc, &out));
+    mpca_desc plain;
+    CHECK_OK(mpca_desc_defaults(&plain, 2, N2, N2, 0));
+    REFUSED(MPCA_STATUS_NOT_ENABLED, mpca_desc_surface_entries(&plain, &disc, &out));
+    plain.size[0] = 15;
+    REFUSED(MPCA_STATUS_SIZE_ODD, mpca_desc_surface_entries(&plain, &disc, &out));
+    CHECK(out == SENTINEL_U32);
+    /* A half-space by mpca_world_add_shape is mpca_world_add_half_space. */
+    mpca_shape floor = shape_of(MPCA_SHAPE_KIND_HALF_SPACE);
+    floor.a[1] = 2.0f;
+    floor.b[1] = 1.0f;
+    CHECK_OK(mpca_world_surface_entries(full2, &floor, &now));
+    CHECK(now == 0); /* full2 has this floor already */
+}
+
 static void obstacle_cases(void) {
     /* In full2: free cell (9, 9), particle (4, 8), surface cell (12, 12),
      * floor rows 0 and 1. In full3: free cell (1, 3, 1). */
@@ -1054,6 +1150,8 @@ static void obstacle_cases(void) {
     unsigned char bare_mask[64] = {0};
     bare_mask[3 * 8 + 3] = 1;
     REFUSED(MPCA_STATUS_NOT_ENABLED, mpca_world_add_obstacle_mask(bare2, bare_mask, 64, e));
+
+    shape_cases();
 
     set_context("surface queries");
     uint32_t empty[3] = {9, 9, 0}, inner[3] = {5, 0, 0}, surface[3] = {12, 12, 0};

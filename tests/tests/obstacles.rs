@@ -635,3 +635,117 @@ fn set_velocities_round_symmetrically() {
     assert_eq!(a[0], -b[0]);
     assert_eq!(a[1], -b[1]);
 }
+
+/// A random shape of `dim` dimensions in a world of `n` cells per axis,
+/// partly outside it at times: a box, a disc or sphere, or a half-space.
+fn random_shape(rng: &mut common::TestRng, dim: u32, n: f32) -> Shape {
+    let mut point = || [0; 3].map(|_| n * (1.4 * rng.unit() - 0.2));
+    let (a, b) = (point(), point());
+    let radius = 0.4 + 0.3 * n * (a[2] / n).abs().min(1.0);
+    let normal = b.map(|c| c - n / 2.0);
+    match (a[0] as u32 + b[1] as u32) % 3 {
+        0 => Shape::Box { min: [0, 1, 2].map(|k| a[k].min(b[k])), max: [0, 1, 2].map(|k| a[k].max(b[k])) },
+        1 if dim == 2 => Shape::Disc { centre: [a[0], a[1]], radius },
+        1 => Shape::Sphere { centre: a, radius },
+        _ => Shape::HalfSpace { point: a, normal },
+    }
+}
+
+/// Issue 27 item 3: the surface entries a shape takes are known before it
+/// is added. Expected, for 150 random shapes (boxes, discs, spheres,
+/// half-spaces, some partly outside) in 2D and 3D worlds with walls, open
+/// faces and periodic axes: `Description::surface_entries` equals the
+/// entries the shape fills in a fresh world, and `World::surface_entries`
+/// of that fresh world; a table of exactly that many takes the shape, and
+/// one entry fewer refuses it whole (`SurfaceTableFull`). A shape that
+/// covers a particle is refused as `add_shape` refuses it.
+#[test]
+fn surface_entries_are_known_before_a_shape_is_added() {
+    let mut rng = common::TestRng::new(27);
+    let worlds = [
+        Description::new_2d(24, 20).with_boundary(Boundary::Wall),
+        Description::new_2d(24, 20).with_boundary(Boundary::Open),
+        Description::new_2d(16, 24).with_boundary(Boundary::Periodic),
+        Description::new_3d(12, 10, 8).with_boundary(Boundary::Wall),
+        Description::new_3d(10, 10, 10).with_boundary(Boundary::Periodic),
+    ];
+    let mut taken = 0;
+    for (i, base) in worlds.iter().enumerate() {
+        for _ in 0..30 {
+            let shape = random_shape(&mut rng, base.dim, base.size[0] as f32);
+            let big = world_with_obstacles(*base);
+            let want = match big.surface_entries(shape) {
+                Ok(n) => n,
+                Err(e) => {
+                    // Refused for the description as for a world.
+                    let mut mem = memory(&big);
+                    let world = World::init(&big, &mut mem).unwrap();
+                    assert_eq!(world.add_shape(shape, 1.0), Err(e), "{shape:?}");
+                    continue;
+                }
+            };
+            let mut fits = big;
+            fits.surface_capacity = want;
+            let mut mem = memory(&fits);
+            let world = World::init(&fits, &mut mem).unwrap();
+            assert_eq!(world.surface_entries(shape), Ok(want), "{shape:?}");
+            world.add_shape(shape, 1.0).unwrap();
+            let filled = common::cells(&fits).filter(|&p| world.surface(p).is_some()).count();
+            assert_eq!(filled, want as usize, "world {i}: {shape:?}");
+            taken += usize::from(want > 0);
+            if want > 0 {
+                let mut short = fits;
+                short.surface_capacity = want - 1;
+                let mut mem = memory(&short);
+                let world = World::init(&short, &mut mem).unwrap();
+                assert_eq!(world.add_shape(shape, 1.0), Err(Error::SurfaceTableFull), "{shape:?}");
+                assert!(common::cells(&short).all(|p| !world.obstacle_at(p)));
+            }
+        }
+    }
+    assert!(taken >= 100, "only {taken} of the shapes had surface cells");
+
+    // A particle under the shape: refused, as the addition would be.
+    let desc = world_with_obstacles(Description::new_2d(16, 16));
+    let mut mem = memory(&desc);
+    let world = World::init(&desc, &mut mem).unwrap();
+    world.add_particle([8, 8, 0], [0.0; 3]).unwrap();
+    let disc = Shape::Disc { centre: [8.0, 8.0], radius: 3.0 };
+    assert_eq!(world.surface_entries(disc), Err(Error::CellOccupied));
+    assert_eq!(world.add_shape(disc, 1.0), Err(Error::CellOccupied));
+    // A description without obstacles has no table to size.
+    assert_eq!(Description::new_2d(16, 16).surface_entries(disc), Err(Error::NotEnabled));
+    assert_eq!(Description::new_2d(15, 16).surface_entries(disc), Err(Error::SizeOdd));
+}
+
+/// The sum of the shapes' entries is a capacity that holds them all, in
+/// any order: where shapes touch or overlap they take fewer. Expected: 12
+/// random shapes in a 3D world of exactly that capacity, added forwards
+/// and backwards, each accepted (or refused as the shape alone is), and the
+/// world's own count before each addition never above the shape's alone.
+#[test]
+fn the_sum_of_surface_entries_holds_every_shape() {
+    let mut rng = common::TestRng::new(28);
+    let base = world_with_obstacles(Description::new_3d(16, 16, 16).with_boundary(Boundary::Wall));
+    let shapes: Vec<Shape> = (0..12).map(|_| random_shape(&mut rng, 3, 16.0)).collect();
+    let alone: Vec<Result<u32, Error>> = shapes.iter().map(|&s| base.surface_entries(s)).collect();
+    let sum: u32 = alone.iter().map(|r| r.unwrap_or(0)).sum();
+    assert!(alone.iter().filter(|r| r.is_ok()).count() >= 8, "{alone:?}");
+    for backwards in [false, true] {
+        let mut desc = base;
+        desc.surface_capacity = sum;
+        let mut mem = memory(&desc);
+        let world = World::init(&desc, &mut mem).unwrap();
+        let order: Vec<usize> = if backwards { (0..12).rev().collect() } else { (0..12).collect() };
+        for i in order {
+            match alone[i] {
+                Ok(n) => {
+                    let now = world.surface_entries(shapes[i]).unwrap();
+                    assert!(now <= n, "{:?}: {now} now, {n} alone", shapes[i]);
+                    world.add_shape(shapes[i], 0.5).unwrap();
+                }
+                Err(e) => assert_eq!(world.add_shape(shapes[i], 0.5), Err(e)),
+            }
+        }
+    }
+}
