@@ -1090,6 +1090,19 @@ mpca_status mpca_world_add_emitter(struct mpca_world *world,
                                    uint32_t *out_index);
 
 /**
+ * What emitter `index` asked for (`out_requested`) and placed
+ * (`out_delivered`) since it was added: each step the whole part of its
+ * rate, and one more by a draw on the fraction, asked; as many placed as
+ * its region had free cells (and ids) for. The difference is its part of
+ * `mpca_stats.emit_shortfall`. MPCA_STATUS_OUT_OF_BOUNDS for an index
+ * past the emitters added.
+ */
+mpca_status mpca_world_emitter_stats(const struct mpca_world *world,
+                                     uint32_t index,
+                                     uint64_t *out_requested,
+                                     uint64_t *out_delivered);
+
+/**
  * Changes the rate of emitter `index`.
  */
 mpca_status mpca_world_set_emitter_rate(struct mpca_world *world, uint32_t index, float rate);

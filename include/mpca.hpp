@@ -116,6 +116,12 @@ struct surface {
     float restitution;
 };
 
+/** What an emitter asked for and placed (world::emitter_stats). */
+struct emitter_counts {
+    std::uint64_t requested;
+    std::uint64_t delivered;
+};
+
 /**
  * The tasks of one step of world::step_parallel, as the host receives
  * them: run each index in [0, count()) once, in any order, on any thread;
@@ -530,6 +536,14 @@ public:
         std::uint32_t index = 0;
         check(mpca_world_add_emitter(w_, &emitter, &index));
         return index;
+    }
+
+    /** What emitter `index` asked for and placed since it was added
+     * (mpca_world_emitter_stats). */
+    emitter_counts emitter_stats(std::uint32_t index) const {
+        emitter_counts c = emitter_counts();
+        check(mpca_world_emitter_stats(w_, index, &c.requested, &c.delivered));
+        return c;
     }
 
     /** Changes the rate of emitter `index`. */

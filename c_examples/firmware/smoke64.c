@@ -20,8 +20,8 @@
 #define SIZE 64
 #define STEPS 120
 
-/* mpca_world_bytes for this scene on 32-bit Arm is 9,703 (alignment slack
- * included), rounded up to 256; main checks it, and names the size it
+/* What mpca_world_bytes asks for this scene on 32-bit Arm (alignment slack
+ * included), with a little room; main checks it, and names the size it
  * needs should a change of the library make it short. */
 #define WORLD_BYTES 9768
 

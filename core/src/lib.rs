@@ -25,7 +25,7 @@ pub use api::error::Error;
 pub use api::owned::WorldBox;
 pub use api::query::{Cell, Particle, Particles, RegionStats, Stats};
 pub use api::snapshot::{image_description, IMAGE_VERSION};
-pub use rules::emitter::Emitter;
+pub use rules::emitter::{Emitter, EmitterStats};
 pub use rules::obstacle::{Shape, Surface};
 pub use step::Order;
 #[cfg(target_has_atomic = "8")]

@@ -51,6 +51,29 @@ pub unsafe extern "C" fn mpca_world_add_emitter(world: *mut mpca_world, emitter:
     })
 }
 
+/// What emitter `index` asked for (`out_requested`) and placed
+/// (`out_delivered`) since it was added: each step the whole part of its
+/// rate, and one more by a draw on the fraction, asked; as many placed as
+/// its region had free cells (and ids) for. The difference is its part of
+/// `mpca_stats.emit_shortfall`. MPCA_STATUS_OUT_OF_BOUNDS for an index
+/// past the emitters added.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mpca_world_emitter_stats(
+    world: *const mpca_world,
+    index: u32,
+    out_requested: *mut u64,
+    out_delivered: *mut u64,
+) -> mpca_status {
+    guard(|c| {
+        let w = c.world_ref(world)?;
+        let (requested, delivered) = (c.out(out_requested)?, c.out(out_delivered)?);
+        let s = w.emitter_stats(index as usize)?;
+        requested.set(s.requested);
+        delivered.set(s.delivered);
+        Ok(())
+    })
+}
+
 /// Changes the rate of emitter `index`.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_world_set_emitter_rate(world: *mut mpca_world, index: u32, rate: f32) -> mpca_status {

@@ -40,6 +40,7 @@ static const struct symbol {
     SYMBOL(mpca_world_add_emitter),
     SYMBOL(mpca_world_set_emitter_rate),
     SYMBOL(mpca_world_set_emitter_tag),
+    SYMBOL(mpca_world_emitter_stats),
     SYMBOL(mpca_world_set_tag),
     SYMBOL(mpca_world_set_gravity),
     SYMBOL(mpca_world_set_force_field),

@@ -293,6 +293,9 @@ static void same_as_c() {
     o.set_emitter_rate(0, 0.0f);
     o.step(5);
     CHECK(o.stats().emitted == 20 && o.cell({16, 12, 0}).kind == MPCA_CELL_KIND_OBSTACLE);
+    /* Rate 2 for 10 steps, then 0: 20 asked for, all placed. */
+    CHECK(o.emitter_stats(0).requested == 20 && o.emitter_stats(0).delivered == 20);
+    THROWS(MPCA_STATUS_OUT_OF_BOUNDS, o.emitter_stats(1));
     mpca_desc d3 = mpca::desc_3d(16, 16, 16);
     d3.obstacles = 1;
     d3.surface_capacity = 512;
@@ -606,6 +609,7 @@ static void every_function() {
     WRAPS(mpca_desc_surface_entries, &mpca::surface_entries);
     WRAPS(mpca_world_add_emitter, &W::add_emitter);
     WRAPS(mpca_world_set_emitter_rate, &W::set_emitter_rate);
+    WRAPS(mpca_world_emitter_stats, &W::emitter_stats);
     std::printf("cpp: every function\n");
 }
 

@@ -865,6 +865,16 @@ static void emitter_cases(void) {
     REFUSED(MPCA_STATUS_OUT_OF_BOUNDS, mpca_world_set_emitter_rate(full2, 2, 1.0f));
     REFUSED(MPCA_STATUS_OUT_OF_BOUNDS, mpca_world_set_emitter_rate(full2, UINT32_MAX, 1.0f));
     REFUSED(MPCA_STATUS_OUT_OF_BOUNDS, mpca_world_set_emitter_rate(bare2, 0, 1.0f));
+    /* Per-emitter counts: full2 has two emitters by now, bare2 none. */
+    uint64_t requested = SENTINEL_U32, delivered = SENTINEL_U32;
+    REFUSED(MPCA_STATUS_OUT_OF_BOUNDS, mpca_world_emitter_stats(full2, 2, &requested, &delivered));
+    REFUSED(MPCA_STATUS_OUT_OF_BOUNDS, mpca_world_emitter_stats(full2, UINT32_MAX, &requested, &delivered));
+    REFUSED(MPCA_STATUS_OUT_OF_BOUNDS, mpca_world_emitter_stats(bare2, 0, &requested, &delivered));
+    REFUSED(MPCA_STATUS_NULL_POINTER, mpca_world_emitter_stats(full2, 0, NULL, &delivered));
+    REFUSED(MPCA_STATUS_NULL_POINTER, mpca_world_emitter_stats(full2, 0, &requested, NULL));
+    CHECK(requested == SENTINEL_U32 && delivered == SENTINEL_U32);
+    CHECK_OK(mpca_world_emitter_stats(full2, 0, &requested, &delivered));
+    CHECK(requested != SENTINEL_U32 && delivered <= requested);
 }
 
 /* Positions outside world `w` of `dim` dimensions and side `n`: each axis

@@ -356,7 +356,7 @@ static void refusals(mpca_world *w2, unsigned char *w2_memory, size_t w2_bytes, 
 
         check_context = "foreign images re-sealed";
         memcpy(damaged, image, n);
-        put_u32(damaged + VERSION_AT, 2);
+        put_u32(damaged + VERSION_AT, 3);
         reseal(damaged, n);
         REFUSED(MPCA_STATUS_IMAGE_VERSION, mpca_world_load(target, damaged, n));
         memcpy(damaged, image, n);

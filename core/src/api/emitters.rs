@@ -2,7 +2,7 @@
 
 use crate::Error;
 use crate::api::checks::finite;
-use crate::rules::emitter::{checked, Emitter, Slot};
+use crate::rules::emitter::{checked, Emitter, EmitterStats, Slot};
 use crate::storage::world::World;
 
 impl World {
@@ -17,9 +17,18 @@ impl World {
         }
         let mass_index = self.mass_index_of(e.mass)?;
         let (head, p) = self.planes::<u8>();
-        p.emitters[used] = Slot { emitter: e, class: u32::from(mass_index) };
+        p.emitters[used] = Slot { emitter: e, class: u32::from(mass_index), stats: EmitterStats::default() };
         head.emitters += 1;
         Ok(used)
+    }
+
+    /// What emitter `index` asked for and placed since it was added; an
+    /// index past the emitters added is `OutOfBounds`.
+    pub fn emitter_stats(&self, index: usize) -> Result<EmitterStats, Error> {
+        if index >= self.head.emitters as usize {
+            return Err(Error::OutOfBounds);
+        }
+        Ok(self.slots()[index].stats)
     }
 
     /// Changes the rate of emitter `index`.

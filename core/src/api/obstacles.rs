@@ -119,7 +119,9 @@ struct Addition<'a> {
 }
 
 impl Addition<'_> {
-    /// Calls `f` with every cell added, stopping at the first error.
+    /// Calls `f` with every cell added, stopping at the first error. Out of
+    /// line: one loop serves every pass.
+    #[inline(never)]
     fn each(&self, f: &mut dyn FnMut([usize; 3]) -> Result<(), Error>) -> Result<(), Error> {
         let (lo, hi) = (self.lo, self.hi);
         for z in lo[2]..hi[2] {

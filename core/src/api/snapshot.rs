@@ -43,7 +43,7 @@ use crate::Error;
 use crate::api::desc::{Boundary, Collisions, Description, Drag, Drift, Forces, Identity, Quantization, Vortex};
 use crate::api::edit::storable;
 use crate::rules::assign::Method;
-use crate::rules::emitter::{checked, Emitter, Slot};
+use crate::rules::emitter::{checked, Emitter, EmitterStats, Slot};
 use crate::rules::obstacle::Surface;
 use crate::rules::quant::{with_quant, Quant};
 use crate::storage::cells::Cells;
@@ -53,9 +53,9 @@ use crate::storage::world::{Counters, World};
 /// The first eight bytes of every image.
 const MAGIC: [u8; 8] = *b"MPCASNAP";
 
-/// The version of the image format this library writes, and the only one it
-/// reads.
-pub const IMAGE_VERSION: u32 = 1;
+/// The version of the image format this library writes. It reads this one
+/// and version 1, whose emitters carry no counts (they load as zero).
+pub const IMAGE_VERSION: u32 = 2;
 
 /// Magic, version, a reserved word and the image's length.
 const HEAD: usize = 24;
@@ -70,8 +70,10 @@ const CHECKSUM: usize = 4;
 /// One surface table entry: cell, normal, restitution, mask flag.
 const SURFACE: usize = 24;
 /// One emitter: region, rate, velocity, spread, mass, lifetime, mass index
-/// and tag.
-const EMITTER: usize = 56;
+/// and tag, then what it asked for and placed.
+const EMITTER: usize = 72;
+/// One emitter in an image of version 1: without the two counts.
+const EMITTER_V1: usize = 56;
 
 /// CRC-32 as zlib, PNG and Ethernet compute it: the reflected polynomial
 /// 0xEDB88320, register preset to all ones and inverted at the end. A table
@@ -227,7 +229,8 @@ fn each_cell(l: &Layout, occupancy: &[u64], f: &mut dyn FnMut(usize)) {
 
 /// Bytes of the image of a world described by `d`, planned as `l`, with
 /// these counts of particles and used table entries.
-fn image_len(d: &Description, l: &Layout, particles: usize, masses: usize, surfaces: usize, emitters: usize) -> Option<usize> {
+/// `emitter` is the bytes of one emitter in the image's version.
+fn image_len(d: &Description, l: &Layout, particles: usize, masses: usize, surfaces: usize, (emitters, emitter): (usize, usize)) -> Option<usize> {
     let (width, _) = width_and_scale(d.quantization);
     let ids = d.identity;
     let per_particle = d.dim as usize * width
@@ -246,7 +249,7 @@ fn image_len(d: &Description, l: &Layout, particles: usize, masses: usize, surfa
         l.wind().len,
         masses.checked_mul(4)?,
         surfaces.checked_mul(SURFACE)?,
-        emitters.checked_mul(EMITTER)?,
+        emitters.checked_mul(emitter)?,
         CHECKSUM,
     ]
     .iter()
@@ -418,21 +421,28 @@ fn put_slot(p: &mut Put<'_>, s: &Slot) {
     p.f32(e.mass);
     p.u32(e.lifetime);
     p.u32(s.class);
+    p.u64(s.stats.requested);
+    p.u64(s.stats.delivered);
 }
 
+/// The emitter of `b`, an image's entry of either version: one of version
+/// 1 is shorter, without the counts, which start from zero.
 fn get_slot(b: &[u8]) -> Slot {
-    let u = |i| le_u32(b, i);
-    let f = |i| f32::from_bits(le_u32(b, i));
+    // The words and counts as arrays: no index below needs a check.
+    let w: [u32; EMITTER_V1 / 4] = core::array::from_fn(|i| le_u32(&b[..EMITTER_V1], i));
+    let f = |i: usize| f32::from_bits(w[i]);
     let emitter = Emitter {
-        min: [u(0), u(1), u(2)],
-        max: [u(3), u(4), u(5)],
+        min: [w[0], w[1], w[2]],
+        max: [w[3], w[4], w[5]],
         rate: f(6),
         velocity: [f(7), f(8), f(9)],
         spread: f(10),
         mass: f(11),
-        lifetime: u(12),
+        lifetime: w[12],
     };
-    Slot { emitter, class: u(13) }
+    let counts = &b[EMITTER_V1..];
+    let count = |i| if counts.len() == 16 { le_u64(counts, i) } else { 0 };
+    Slot { emitter, class: w[13], stats: EmitterStats { requested: count(0), delivered: count(1) } }
 }
 
 /// An image checked in full; its planes are still the image's bytes.
@@ -444,6 +454,9 @@ struct Image<'a> {
     masses: usize,
     surfaces: usize,
     emitters: usize,
+    /// Bytes of one emitter: [`EMITTER`], or [`EMITTER_V1`] in an image
+    /// of version 1.
+    emitter_len: usize,
     occupancy: &'a [u8],
     obstacle: &'a [u8],
     velocity: &'a [u8],
@@ -481,9 +494,11 @@ fn read(image: &[u8]) -> Result<Image<'_>, Error> {
         return Err(Error::ImageLength);
     }
     let mut g = Get { rest: &image[MAGIC.len()..] };
-    if g.u32()? != IMAGE_VERSION {
-        return Err(Error::ImageVersion);
-    }
+    let emitter_len = match g.u32()? {
+        1 => EMITTER_V1,
+        IMAGE_VERSION => EMITTER,
+        _ => return Err(Error::ImageVersion),
+    };
     let reserved = g.u32()?;
     if g.u64()? != image.len() as u64 {
         return Err(Error::ImageLength);
@@ -529,7 +544,7 @@ fn read(image: &[u8]) -> Result<Image<'_>, Error> {
     {
         return Err(bad);
     }
-    if image_len(&desc, &layout, particles as usize, masses, surfaces, emitters) != Some(image.len()) {
+    if image_len(&desc, &layout, particles as usize, masses, surfaces, (emitters, emitter_len)) != Some(image.len()) {
         return Err(bad);
     }
     let (width, _) = width_and_scale(desc.quantization);
@@ -543,6 +558,7 @@ fn read(image: &[u8]) -> Result<Image<'_>, Error> {
         masses,
         surfaces,
         emitters,
+        emitter_len,
         occupancy: g.take(layout.occupancy().len)?,
         obstacle: g.take(layout.obstacle().len)?,
         velocity: g.take(n * dim * width)?,
@@ -557,7 +573,7 @@ fn read(image: &[u8]) -> Result<Image<'_>, Error> {
         wind: g.take(layout.wind().len)?,
         mass_table: g.take(4 * masses)?,
         surface: g.take(SURFACE * surfaces)?,
-        emitter: g.take(EMITTER * emitters)?,
+        emitter: g.take(emitter_len * emitters)?,
     };
     check(&img)?;
     Ok(img)
@@ -658,9 +674,13 @@ fn check(img: &Image<'_>) -> Result<(), Error> {
     }
 
     // Emitters: what add_emitter accepts, stored as it stores them.
-    for b in img.emitter.chunks_exact(EMITTER) {
+    for b in img.emitter.chunks_exact(img.emitter_len) {
         let s = get_slot(b);
         let e = s.emitter;
+        // Nothing is placed that was not asked for.
+        if s.stats.delivered > s.stats.requested {
+            return bad;
+        }
         let mut stored = e;
         if checked(&mut stored, dim, l.n, d.lifetimes).is_err() || stored != e {
             return bad;
@@ -760,7 +780,7 @@ fn apply(w: &mut World, img: &Image<'_>) {
             *s = get_surface(b);
         }
         p.emitters.fill(Slot::default());
-        for (s, b) in p.emitters.iter_mut().zip(img.emitter.chunks_exact(EMITTER)) {
+        for (s, b) in p.emitters.iter_mut().zip(img.emitter.chunks_exact(img.emitter_len)) {
             *s = get_slot(b);
         }
     }
@@ -792,7 +812,7 @@ impl World {
         let h = &self.head;
         let occupancy: &[u64] = self.plane(h.layout.occupancy());
         let particles = ones(occupancy);
-        image_len(&h.desc, &h.layout, particles, h.masses as usize, h.surfaces as usize, h.emitters as usize).unwrap_or(usize::MAX)
+        image_len(&h.desc, &h.layout, particles, h.masses as usize, h.surfaces as usize, (h.emitters as usize, EMITTER)).unwrap_or(usize::MAX)
     }
 
     /// Writes the world's image (M12) to the start of `out` and returns its

@@ -42,6 +42,23 @@ pub(crate) struct Slot {
     /// the tag they carry where the world has tags (M6b): the word an
     /// image holds (M12).
     pub class: u32,
+    /// What the emitter asked for and what it placed over its life (M6):
+    /// see [`EmitterStats`].
+    pub stats: EmitterStats,
+}
+
+/// What one emitter asked for and what it placed, counted from when it was
+/// added (saturating). The difference is its part of the world's
+/// shortfall: particles its region had no free cell for, or no id was left
+/// for (M6b).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[repr(C)]
+pub struct EmitterStats {
+    /// Particles asked for: each step the whole part of its rate, and one
+    /// more where the step's draw falls below the fraction.
+    pub requested: u64,
+    /// Particles placed.
+    pub delivered: u64,
 }
 
 impl Slot {

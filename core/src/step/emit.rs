@@ -54,6 +54,9 @@ impl World {
             };
             each_site(grid, &e, |s| chosen(self, s));
             // Saturating: an image (M12) may carry any count.
+            let stats = &mut self.planes::<u8>().1.emitters[i].stats;
+            stats.requested = stats.requested.saturating_add(wanted);
+            stats.delivered = stats.delivered.saturating_add(placing as u64);
             self.head.counters.emitted = self.head.counters.emitted.saturating_add(placing as u64);
             self.head.counters.particles += placing as u64;
         }
