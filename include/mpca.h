@@ -1083,7 +1083,9 @@ mpca_status mpca_desc_validate(const struct mpca_desc *desc);
 mpca_status mpca_world_bytes(const struct mpca_desc *desc, size_t *out_bytes);
 
 /**
- * Adds an emitter; its index goes to `out_index`.
+ * Adds an emitter; its index goes to `out_index`. A world described with
+ * `emitter_capacity` 0 has no room for one: MPCA_STATUS_NOT_ENABLED; one
+ * whose room is taken: MPCA_STATUS_EMITTER_TABLE_FULL.
  */
 mpca_status mpca_world_add_emitter(struct mpca_world *world,
                                    const struct mpca_emitter *emitter,

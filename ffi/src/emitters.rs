@@ -29,7 +29,9 @@ pub struct mpca_emitter {
     pub lifetime: u32,
 }
 
-/// Adds an emitter; its index goes to `out_index`.
+/// Adds an emitter; its index goes to `out_index`. A world described with
+/// `emitter_capacity` 0 has no room for one: MPCA_STATUS_NOT_ENABLED; one
+/// whose room is taken: MPCA_STATUS_EMITTER_TABLE_FULL.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_world_add_emitter(world: *mut mpca_world, emitter: *const mpca_emitter, out_index: *mut u32) -> mpca_status {
     guard(|c| {

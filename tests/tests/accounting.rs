@@ -182,6 +182,25 @@ fn each_emitter_counts_what_it_asked_for_and_placed() {
     assert_eq!(world.emitter_stats(2), Err(mpca::Error::OutOfBounds));
 }
 
+/// Issue 27 item 3: a world described without room for emitters says the
+/// part is off, not that a table is full. Expected: `NotEnabled` with
+/// `emitter_capacity` 0; with 1, the first emitter is index 0 and the
+/// second `EmitterTableFull`.
+#[test]
+fn no_room_for_emitters_is_not_a_full_table() {
+    let e = Emitter { min: [0, 0, 0], max: [2, 2, 1], rate: 1.0, mass: 1.0, ..Emitter::default() };
+    for (capacity, second) in [(0, mpca::Error::NotEnabled), (1, mpca::Error::EmitterTableFull)] {
+        let mut desc = Description::new_2d(8, 8);
+        desc.emitter_capacity = capacity;
+        let mut mem = memory(&desc);
+        let world = World::init(&desc, &mut mem).unwrap();
+        if capacity == 1 {
+            assert_eq!(world.add_emitter(e), Ok(0));
+        }
+        assert_eq!(world.add_emitter(e), Err(second), "capacity {capacity}");
+    }
+}
+
 /// M6 lifetimes: a particle emitted with lifetime L is processed L times:
 /// it is seen after steps 1 .. L-1 with life L-1 .. 1 (steps left) and
 /// expires during step L. A particle added by hand has life 0 (no limit).

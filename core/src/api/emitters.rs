@@ -6,14 +6,17 @@ use crate::rules::emitter::{checked, Emitter, EmitterStats, Slot};
 use crate::storage::world::World;
 
 impl World {
-    /// Adds an emitter and returns its index.
+    /// Adds an emitter and returns its index. A world described with no
+    /// room for emitters (`emitter_capacity` 0) has none to fill:
+    /// `NotEnabled`; one whose room is taken, `EmitterTableFull`.
     pub fn add_emitter(&mut self, mut e: Emitter) -> Result<usize, Error> {
         checked(&mut e, self.dim(), self.layout().n, self.head.desc.lifetimes)?;
         let used = self.head.emitters as usize;
         // The capacity the plane was sized for (`Layout::of`), without a
         // division by the slot's size.
-        if used >= self.head.desc.emitter_capacity as usize {
-            return Err(Error::EmitterTableFull);
+        let capacity = self.head.desc.emitter_capacity as usize;
+        if used >= capacity {
+            return Err(if capacity == 0 { Error::NotEnabled } else { Error::EmitterTableFull });
         }
         let mass_index = self.mass_index_of(e.mass)?;
         let (head, p) = self.planes::<u8>();
