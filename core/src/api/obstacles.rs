@@ -204,7 +204,7 @@ impl Description {
     /// `NotEnabled` for a description without obstacles.
     pub fn surface_entries(&self, shape: Shape) -> Result<u32, Error> {
         let l = self.plan()?;
-        if !self.obstacles {
+        if !self.has_obstacles() {
             return Err(Error::NotEnabled);
         }
         let frame = Frame { n: l.n, boundary: self.boundary, dim: self.dim as usize };
@@ -245,7 +245,7 @@ impl World {
     /// also checks the restitution). Refused as `add_shape` would refuse
     /// the shape: `CellOccupied` if it covers a particle, and so on.
     pub fn surface_entries(&self, shape: Shape) -> Result<u32, Error> {
-        if !self.head.desc.obstacles {
+        if !self.head.desc.has_obstacles() {
             return Err(Error::NotEnabled);
         }
         Addition::of_shape(shape, &self.frame(), &mut |a| self.entries_added(a)).map(|n| n as u32)
@@ -285,7 +285,8 @@ impl World {
     /// everything against the obstacles as they will be
     /// ([`Before::entries_added`]), the second writes.
     fn add_obstacles(&mut self, a: &Addition<'_>, e: f32, from_mask: bool) -> Result<(), Error> {
-        if !self.head.desc.obstacles {
+        // `has_obstacles`: a build without obstacles keeps none of this.
+        if !self.head.desc.has_obstacles() {
             return Err(Error::NotEnabled);
         }
         restitution(e)?;
