@@ -1,5 +1,6 @@
 //! Writes the seed corpus of the fuzz targets into fuzz/seeds/<target>/,
-//! replacing what is there. From the repository root:
+//! replacing what it wrote before (snapshot seeds kept by hand stay). From
+//! the repository root:
 //!
 //!     cargo +nightly run --manifest-path fuzz/Cargo.toml --example seeds
 //!
@@ -108,11 +109,14 @@ fn write(dir: &Path, name: &str, bytes: &[u8]) {
 fn main() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("seeds");
     let mut bytes = Bytes(0x6d70_6361_7365_6564);
-    for target in ["desc", "ops", "snapshot"] {
+    for target in ["desc", "ops"] {
         let dir = root.join(target);
         let _ = fs::remove_dir_all(&dir);
         fs::create_dir_all(&dir).expect("the seeds folder");
     }
+    // The images it writes are replaced; the ones kept by hand (inputs the
+    // fuzzer once found) stay.
+    fs::create_dir_all(root.join("snapshot")).expect("the seeds folder");
 
     for (i, d) in descriptions().iter().enumerate() {
         assert_eq!(validate(d), mpca_status::Ok);
@@ -142,4 +146,9 @@ fn main() {
         seed.extend(w.save());
         write(&root.join("snapshot"), &format!("image-{i}"), &seed);
     }
+    // An image of format version 1 (M12), which the library still reads:
+    // the one the integration tests load.
+    let mut seed = vec![0u8];
+    seed.extend(include_bytes!("../../tests/data/small-world-20-v1.mpca"));
+    write(&root.join("snapshot"), "version-1", &seed);
 }
