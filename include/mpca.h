@@ -667,7 +667,8 @@ typedef struct mpca_desc {
    */
   uint32_t obstacles;
   /**
-   * How many obstacle surface cells fit.
+   * How many obstacle surface cells fit; mpca_desc_surface_entries says
+   * how many a shape takes.
    */
   uint32_t surface_capacity;
   /**

@@ -108,7 +108,8 @@ pub struct mpca_desc {
     pub mass_classes: u32,
     /// 1: the world has obstacles.
     pub obstacles: u32,
-    /// How many obstacle surface cells fit.
+    /// How many obstacle surface cells fit; mpca_desc_surface_entries says
+    /// how many a shape takes.
     pub surface_capacity: u32,
     /// `mpca_force` bits.
     pub forces: u32,

@@ -206,7 +206,8 @@ pub struct Description {
     pub mass_classes: u32,
     /// Whether the world has obstacle cells (feature `obstacles`).
     pub obstacles: bool,
-    /// How many obstacle surface cells (with normal and restitution) fit.
+    /// How many obstacle surface cells (with normal and restitution) fit;
+    /// [`Description::surface_entries`] says how many a shape takes.
     pub surface_capacity: u32,
     /// Which force terms are summed (M5.1).
     pub forces: Forces,
