@@ -749,3 +749,29 @@ fn the_sum_of_surface_entries_holds_every_shape() {
         }
     }
 }
+
+/// The issue's case (issue 27 item 3): the paper's water scene's sphere
+/// (radius 10 in a walled 64^3 box) needed "between 1,651 and 1,700" surface
+/// entries, found by bisection on `surface_capacity`. Expected: its
+/// description says the exact count, inside that bracket; the scene's world
+/// built with exactly that capacity sets up (sphere and emitter), and with
+/// one entry fewer is refused with `SurfaceTableFull`.
+#[test]
+fn the_water_scenes_sphere_is_sized_before_its_world_is_made() {
+    let scene = mpca_tests::scenes::water();
+    let sphere = Shape::Sphere { centre: [32.0, 28.0, 32.0], radius: 10.0 };
+    let entries = scene.desc.surface_entries(sphere).unwrap();
+    println!("the water scene's sphere takes {entries} surface entries");
+    assert!((1651..=1700).contains(&entries), "{entries}");
+    for (capacity, fits) in [(entries, true), (entries - 1, false)] {
+        let mut desc = scene.desc;
+        desc.surface_capacity = capacity;
+        let mut mem = memory(&desc);
+        let world = World::init(&desc, &mut mem).unwrap();
+        let r = (scene.setup)(world);
+        assert_eq!(r.is_ok(), fits, "capacity {capacity}: {r:?}");
+        if !fits {
+            assert_eq!(r, Err(Error::SurfaceTableFull));
+        }
+    }
+}
