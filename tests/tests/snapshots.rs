@@ -737,7 +737,7 @@ fn the_format_of_version_2_is_pinned() {
 /// by the library of version 1. Expected: it loads into a world of its
 /// description as the same world (hash, counters) with emitter counts of
 /// zero, and steps on as the world it was saved from; saved again it is
-/// an image of version 2, 16 bytes longer (one emitter's two counts).
+/// an image of version 2, longer by its one emitter's two counts.
 #[test]
 fn images_of_version_1_still_load() {
     let v1 = include_bytes!("../data/small-world-20-v1.mpca");

@@ -441,7 +441,7 @@ fn get_slot(b: &[u8]) -> Slot {
         lifetime: w[12],
     };
     let counts = &b[EMITTER_V1..];
-    let count = |i| if counts.len() == 16 { le_u64(counts, i) } else { 0 };
+    let count = |i| if counts.len() == EMITTER - EMITTER_V1 { le_u64(counts, i) } else { 0 };
     Slot { emitter, class: w[13], stats: EmitterStats { requested: count(0), delivered: count(1) } }
 }
 
