@@ -18,6 +18,7 @@ mod step;
 mod storage;
 
 pub use rules::{assign, rng};
+pub use api::port;
 pub use assign::Method;
 pub use api::desc::{Boundary, Collisions, Description, Drag, Drift, Forces, Identity, Quantization, Vortex};
 pub use api::error::Error;

@@ -11,6 +11,7 @@ pub(crate) mod hash;
 pub(crate) mod obstacles;
 #[cfg(feature = "alloc")]
 pub(crate) mod owned;
+pub mod port;
 pub(crate) mod query;
 pub(crate) mod snapshot;
 pub(crate) mod speed;

@@ -319,7 +319,7 @@ fn convert_classes<'a>(masses: &[f32], dt: f32, scale: (u32, i32), swirl: Option
 
 /// The class of mass `m` (`(m, e)`, [`magnitude`]) where `largest` is the
 /// largest mass in use: [`convert_classes`] for one class.
-fn convert_class(m: (u32, i32), largest: (u32, i32), dt: f32, (s, fine): (u32, i32), swirl: Option<Swirl>) -> Class {
+pub(crate) fn convert_class(m: (u32, i32), largest: (u32, i32), dt: f32, (s, fine): (u32, i32), swirl: Option<Swirl>) -> Class {
     let push = quot(magnitude(dt), m, 0);
     Class {
         push,

@@ -264,6 +264,16 @@ pub(crate) fn optimal_moves_2d(key: usize) -> &'static [Move2] {
     listed_moves_2d(list)
 }
 
+/// The moves [`TABLE_2D`] lists for `key`, `None` where it lists none
+/// (a state the step never poses), for a second implementation of the
+/// step (`port`).
+pub(crate) fn moves_of_key_2d(key: usize) -> Option<&'static [Move2]> {
+    match TABLE_2D.list.get(key) {
+        None | Some(&UNLISTED) => None,
+        Some(&list) => Some(listed_moves_2d(list)),
+    }
+}
+
 /// The moves of list number `list` of [`TABLE_2D`].
 #[inline]
 fn listed_moves_2d(list: u8) -> &'static [Move2] {

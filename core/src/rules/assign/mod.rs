@@ -54,7 +54,7 @@ use exhaustive::exhaustive;
 use greedy::greedy;
 
 // The step looks its 2D blocks up in the table itself.
-pub(crate) use exact_fast_2d::{optimal_moves_2d, pick_move, PLACE_2D};
+pub(crate) use exact_fast_2d::{moves_of_key_2d, optimal_moves_2d, pick_move, PLACE_2D};
 // The step's tests build table keys with it.
 #[cfg(test)]
 pub(crate) use exact_fast_2d::digit;

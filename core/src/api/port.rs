@@ -1,0 +1,161 @@
+//! What a second implementation of the step needs from this one: the
+//! integers a step converts its settings to (M1c), the tables of the rule
+//! (M5.2's turns, M5.3's move limits, M5.6's 2D assignments), the world's
+//! occupancy and velocity planes to copy in and out, and the counters and
+//! step number it hands back. The GPU backend (`mpca-gpu`) is one: it runs
+//! the block rule in a shader and keeps this crate's worlds, so that both
+//! give the same world bit for bit (M8b). Nothing here is needed to use a
+//! world.
+
+use crate::api::desc::Drift;
+use crate::rules::fixed::{magnitude, parts};
+use crate::rules::quant::Quant;
+use crate::rules::rng::StepKey;
+use crate::step::convert_class;
+use crate::step::partition::Partition;
+use crate::storage::world::{Counters, World};
+
+/// The integers one step of a world reads, converted from its description
+/// as the step converts them (M1c, M8).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct StepConstants {
+    /// The step's number: its parity is the partition's offset (M3).
+    pub step: u64,
+    /// M8: block `b`'s stream starts at the counter `key + stride b` and
+    /// adds `gamma` before each output.
+    pub key: u64,
+    /// See `key`.
+    pub gamma: u64,
+    /// See `key`: `gamma` times the counters a block owns.
+    pub stride: u64,
+    /// M5.2's restitution `E` in Q16.
+    pub restitution: i32,
+    /// The world's unit speed `W` in fine units (M1c).
+    pub unit: i32,
+    /// Fine bits per quantum, `F` (M1c).
+    pub fine: u32,
+    /// M5.5's energy factor `h` of the world's mass as `h = m 2^e`: the
+    /// counter adds `floor(n h)` for `n` cut to its top 40 bits.
+    pub energy: (u32, i32),
+    /// M5.3: per stored 8-bit component (as a byte), the largest 16
+    /// random bits that say "move".
+    pub moves: &'static [u16; 256],
+}
+
+/// What steps run elsewhere counted (the fields of [`crate::Stats`] of the
+/// same names), handed back by [`World::port_count_steps`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct StepCounts {
+    /// Steps run.
+    pub steps: u64,
+    /// Over those steps.
+    pub collisions: u64,
+    /// Over those steps.
+    pub clamps: u64,
+    /// Over those steps, saturating.
+    pub clamp_energy: u64,
+    /// Over those steps.
+    pub displaced: u64,
+    /// Over those steps.
+    pub exited: u64,
+    /// In the last of those steps.
+    pub blocks_processed: u64,
+}
+
+/// A world's occupancy and velocity planes, as the step reads them.
+pub struct PortPlanes<'a> {
+    /// One bit a cell, `row_words` 64-bit words a row of `nx` cells (the
+    /// last padded with zeros), rows in `y + ny z` order.
+    pub occupancy: &'a mut [u64],
+    /// 64-bit words a row of the occupancy.
+    pub row_words: usize,
+    /// The stored velocity components, `dim` a cell in dense cell order,
+    /// one byte each (8-bit worlds) or two (16-bit, little-endian). What an
+    /// empty cell holds is never read.
+    pub velocity: &'a mut [u8],
+}
+
+impl World {
+    /// The integers of the step `ahead` steps after the one this world
+    /// takes next (M1c, M8): a backend that runs several steps before it
+    /// counts them into this world ([`World::port_count_steps`]) asks
+    /// with the steps it has run.
+    pub fn port_constants_ahead(&self, ahead: u64) -> StepConstants {
+        let step = self.head.step.wrapping_add(ahead);
+        let desc = &self.head.desc;
+        let unit = crate::rules::quant::with_quant!(desc.quantization, Q => Q::UNIT);
+        let (s, fine) = (unit >> unit.trailing_zeros(), unit.trailing_zeros());
+        let class = convert_class(magnitude(desc.mass), magnitude(desc.mass), desc.dt, (s as u32, fine as i32), None);
+        let (_, m, e) = parts(class.energy);
+        let (key, gamma, stride) = StepKey::blocks(desc.seed, step).parts();
+        StepConstants {
+            step,
+            key,
+            gamma,
+            stride,
+            restitution: crate::rules::fixed::scaled(desc.restitution, 1.0, 16) as i32,
+            unit,
+            fine,
+            energy: (m as u32, e),
+            moves: crate::rules::quant::move_table_8(desc.drift),
+        }
+    }
+
+    /// The occupancy and velocity planes, to copy a world out or in. The
+    /// step's summaries of empty rows and words are marked "may hold a
+    /// particle" everywhere, so that whatever is written here, the next
+    /// step sweeps it (M3); the particle count is not changed.
+    pub fn port_planes(&mut self) -> PortPlanes<'_> {
+        let row_words = self.layout().row_words;
+        let (_, p) = self.planes::<u8>();
+        p.rows.fill(1);
+        p.words.fill(u64::MAX);
+        PortPlanes { occupancy: p.occupancy, row_words, velocity: p.velocity }
+    }
+
+    /// Counts `c.steps` steps that ran elsewhere (the emitters and the
+    /// sweep of each) into this world: adds their counters, sets the last
+    /// step's processed and skipped blocks and advances the step number.
+    /// The occupancy must already be the one they left ([`World::port_planes`]).
+    pub fn port_count_steps(&mut self, c: &StepCounts) {
+        if c.steps == 0 {
+            return;
+        }
+        let last = self.head.step.wrapping_add(c.steps - 1);
+        let part = Partition::new(self.layout(), &self.head.desc.boundary, self.dim(), last);
+        let total = part.total_blocks();
+        let h = &mut self.head.counters;
+        h.add_step(&Counters {
+            exited: c.exited,
+            collisions: c.collisions,
+            clamps: c.clamps,
+            clamp_energy: c.clamp_energy,
+            displaced: c.displaced,
+            ..Counters::default()
+        });
+        h.particles = h.particles.saturating_sub(c.exited);
+        h.processed = c.blocks_processed;
+        h.skipped = total.saturating_sub(c.blocks_processed);
+        self.head.step = self.head.step.wrapping_add(c.steps);
+    }
+}
+
+/// M5.2 in 2D: the turn `j` of 1,024 as `(round(2^30 cos), round(2^30 sin))`.
+pub fn turn(j: u32) -> (i32, i32) {
+    crate::rules::fixed::turn(j & (crate::rules::fixed::TURNS - 1))
+}
+
+/// M5.6 in 2D, exact-fast: the optimal assignments of the block state
+/// `key` (one digit of six a cell, place values 1, 6, 36, 216: 0 free, 1
+/// blocked, `2 + m` a particle that wants to cross the axes `m`), each
+/// packed as bits `2c, 2c + 1` the cell the particle in cell `c` goes to
+/// and bits 12-14 how many do not get the cell they want; `None` for a
+/// state the step never poses (a wish for a blocked cell).
+pub fn optimal_moves_2d(key: usize) -> Option<&'static [u16]> {
+    crate::rules::assign::moves_of_key_2d(key)
+}
+
+/// M5.3's table for 8-bit storage under `drift`, as [`StepConstants::moves`].
+pub fn move_table_8(drift: Drift) -> &'static [u16; 256] {
+    crate::rules::quant::move_table_8(drift)
+}

@@ -1,0 +1,315 @@
+//! The block rule of `mpca` on the GPU: a [`GpuWorld`] steps a world in a
+//! WGSL compute shader (`step2d.wgsl`) and stays equal to the CPU's world
+//! bit for bit (M8b in `docs/model.md`): the same hash, counters and
+//! snapshot image after every step.
+//!
+//! The world lives in GPU buffers: the occupancy, one bit a cell as the CPU
+//! keeps it, and the stored velocities, as bytes, each in a pair of buffers
+//! that the steps read and write in turn. A copy of the world on the CPU
+//! (an [`mpca::World`]) keeps what does not change in a step (the
+//! description) and what a step counts; [`GpuWorld::sync`] brings the
+//! planes and the counters down into it, and from there come the hash, the
+//! statistics and the snapshot image.
+//!
+//! This version runs the 2D rule with 8-bit velocities on periodic faces:
+//! collisions (M5.2, one mass, any restitution), both drift rules (M5.3)
+//! and the exact-fast assignment (M5.6) — the gas the benchmark runs. A
+//! description that needs any other part is refused when the world is
+//! made, as a CPU build without that part refuses it
+//! ([`mpca::Error::FeatureDisabled`]).
+
+use mpca::port::{StepCounts, StepConstants};
+use mpca::{Boundary, Collisions, Description, Identity, Method, Quantization, World, WorldBox};
+use wgpu::util::DeviceExt;
+
+/// Why a GPU world could not be made or stepped.
+#[derive(Debug)]
+pub enum Error {
+    /// What the CPU world says: a bad description, or a part this backend
+    /// does not run ([`mpca::Error::FeatureDisabled`]).
+    World(mpca::Error),
+    /// No adapter (a GPU, or a software one such as lavapipe) was found.
+    NoAdapter(String),
+    /// The adapter would not give a device.
+    Device(String),
+}
+
+impl core::fmt::Display for Error {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            Error::World(e) => write!(f, "{e}"),
+            Error::NoAdapter(why) => write!(f, "no GPU adapter: {why}"),
+            Error::Device(why) => write!(f, "the GPU adapter gave no device: {why}"),
+        }
+    }
+}
+
+impl std::error::Error for Error {}
+
+impl From<mpca::Error> for Error {
+    fn from(e: mpca::Error) -> Self {
+        Error::World(e)
+    }
+}
+
+/// A device and its queue: made here ([`Gpu::new`]), or the caller's
+/// ([`Gpu::from_device`]), as an engine that owns its device has them.
+#[derive(Clone)]
+pub struct Gpu {
+    /// The device the worlds' buffers and shaders live on.
+    pub device: wgpu::Device,
+    /// Its queue.
+    pub queue: wgpu::Queue,
+    /// The adapter's name and driver, where this made the device.
+    pub adapter: String,
+}
+
+impl Gpu {
+    /// A device on the first adapter wgpu finds (the `WGPU_BACKEND` and
+    /// `WGPU_ADAPTER_NAME` variables of wgpu choose another).
+    pub fn new() -> Result<Gpu, Error> {
+        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        let options = wgpu::RequestAdapterOptions { power_preference: wgpu::PowerPreference::HighPerformance, ..Default::default() };
+        let adapter = pollster::block_on(instance.request_adapter(&options)).map_err(|e| Error::NoAdapter(e.to_string()))?;
+        let info = adapter.get_info();
+        let descriptor = wgpu::DeviceDescriptor { label: Some("mpca"), required_limits: adapter.limits(), ..Default::default() };
+        let (device, queue) = pollster::block_on(adapter.request_device(&descriptor)).map_err(|e| Error::Device(e.to_string()))?;
+        Ok(Gpu { device, queue, adapter: format!("{} ({:?}, {})", info.name, info.backend, info.driver_info) })
+    }
+
+    /// The caller's device and queue.
+    pub fn from_device(device: wgpu::Device, queue: wgpu::Queue) -> Gpu {
+        Gpu { device, queue, adapter: String::from("the caller's device") }
+    }
+}
+
+/// Why this backend cannot run a description: `None` where it can.
+pub fn unsupported(d: &Description) -> Option<&'static str> {
+    let periodic = (0..2).all(|k| d.boundary[k] == [Boundary::Periodic; 2]);
+    let checks: [(bool, &'static str); 13] = [
+        (d.dim == 2, "3D worlds"),
+        (d.quantization == Quantization::Bits8, "16-bit velocities"),
+        (periodic, "faces that are not periodic"),
+        (!d.per_particle_mass, "per-particle masses"),
+        (!d.obstacles, "obstacles"),
+        (!(d.forces.uniform || d.forces.field || d.forces.potential || d.forces.vortex), "forces"),
+        (d.drag.rate == 0.0, "flow drag"),
+        (d.method == Method::ExactFast, "an assignment other than exact-fast"),
+        (d.collisions == Collisions::Paper, "speed-limited collisions"),
+        (!d.contacts, "contacts"),
+        (!d.energy_neutral, "energy-neutral rounding"),
+        (d.emitter_capacity == 0 && !d.lifetimes, "emitters and lifetimes"),
+        (d.identity == Identity::NONE, "ids, ages and tags"),
+    ];
+    checks.iter().find(|(ok, _)| !ok).map(|(_, what)| *what)
+}
+
+/// Where the tables lie in the shader's table buffer (`step2d.wgsl`).
+const TURNS_AT: usize = 256;
+const KEYS_AT: usize = 2304;
+const LISTS_AT: usize = 3600;
+const KEYS_2D: usize = 1296;
+
+/// The rule's tables as the shader reads them: M5.3's move limits, M5.2's
+/// turns and M5.6's 2D assignments, from the core crate.
+fn tables(moves: &[u16; 256]) -> Vec<u32> {
+    let mut t = vec![0u32; LISTS_AT];
+    for (i, &m) in moves.iter().enumerate() {
+        t[i] = u32::from(m);
+    }
+    for j in 0..1024u32 {
+        let (c, s) = mpca::port::turn(j);
+        t[TURNS_AT + 2 * j as usize] = c as u32;
+        t[TURNS_AT + 2 * j as usize + 1] = s as u32;
+    }
+    for key in 0..KEYS_2D {
+        if let Some(list) = mpca::port::optimal_moves_2d(key) {
+            let start = t.len() - LISTS_AT;
+            t[KEYS_AT + key] = start as u32 | (list.len() as u32) << 16;
+            t.extend(list.iter().map(|&m| u32::from(m)));
+        }
+    }
+    t
+}
+
+/// The counters buffer: pairs (low, high) of collisions, clamps, clamp
+/// energy, displaced, exited; the blocks processed in the step; a flag for
+/// a saturated clamp energy.
+const COUNTERS: usize = 12;
+
+/// A world stepped on the GPU, equal to the CPU's bit for bit.
+pub struct GpuWorld {
+    gpu: Gpu,
+    /// The world's copy on the CPU: its description, and its planes and
+    /// counters as of the last [`GpuWorld::sync`].
+    host: WorldBox,
+    /// Steps run on the GPU since the last sync.
+    pending: u64,
+    pipeline: wgpu::ComputePipeline,
+    params: wgpu::Buffer,
+    occupancy: [wgpu::Buffer; 2],
+    velocity: [wgpu::Buffer; 2],
+    counters: wgpu::Buffer,
+    /// `groups[i]` reads pair member `i` and writes the other.
+    groups: [wgpu::BindGroup; 2],
+    /// The member of each pair that holds the world now.
+    current: usize,
+    /// Workgroups along x (occupancy words) and y (rows of blocks).
+    dispatch: [u32; 2],
+}
+
+impl GpuWorld {
+    /// A GPU world holding `world`'s state (a copy: `world` is not
+    /// changed). Refused with [`mpca::Error::FeatureDisabled`] where the
+    /// description needs a part this backend does not run ([`unsupported`]).
+    pub fn new(gpu: &Gpu, world: &World) -> Result<GpuWorld, Error> {
+        if unsupported(world.description()).is_some() {
+            return Err(Error::World(mpca::Error::FeatureDisabled));
+        }
+        let mut image = vec![0u8; world.snapshot_bytes()];
+        world.save(&mut image)?;
+        let mut host = WorldBox::new(world.description())?;
+        host.load(&image)?;
+        let device = &gpu.device;
+        let desc = *host.description();
+        let (nx, ny) = (desc.size[0], desc.size[1]);
+        let (occupancy, velocity) = {
+            let p = host.port_planes();
+            (bytemuck::cast_slice::<u64, u8>(p.occupancy).to_vec(), p.velocity.to_vec())
+        };
+        let storage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
+        let buffer = |label: &str, bytes: &[u8]| {
+            // A buffer's size is a multiple of 4 bytes, at least 4.
+            let mut contents = bytes.to_vec();
+            contents.resize(bytes.len().next_multiple_of(4).max(4), 0);
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents: &contents, usage: storage })
+        };
+        let occupancy = [buffer("occupancy 0", &occupancy), buffer("occupancy 1", &occupancy)];
+        let velocity = [buffer("velocity 0", &velocity), buffer("velocity 1", &velocity)];
+        let counters = buffer("counters", &[0u8; 4 * COUNTERS]);
+        let params = buffer("params", &[0u8; 4 * 16]);
+        let tables = buffer("tables", bytemuck::cast_slice(&tables(mpca::port::move_table_8(desc.drift))));
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some("step2d.wgsl"), source: wgpu::ShaderSource::Wgsl(include_str!("step2d.wgsl").into()) });
+        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("step 2D"),
+            layout: None,
+            module: &module,
+            entry_point: Some("step_2d"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        let layout = pipeline.get_bind_group_layout(0);
+        let group = |from: usize| {
+            let to = 1 - from;
+            let entries = [&params, &tables, &occupancy[from], &velocity[from], &occupancy[to], &velocity[to], &counters];
+            let entries: Vec<wgpu::BindGroupEntry<'_>> = entries.iter().enumerate().map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() }).collect();
+            device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("step"), layout: &layout, entries: &entries })
+        };
+        let groups = [group(0), group(1)];
+        let words = nx.div_ceil(32);
+        Ok(GpuWorld {
+            gpu: gpu.clone(),
+            host,
+            pending: 0,
+            pipeline,
+            params,
+            occupancy,
+            velocity,
+            counters,
+            groups,
+            current: 0,
+            dispatch: [words.div_ceil(64), ny / 2],
+        })
+    }
+
+    /// Runs `n` steps on the GPU. Nothing is read back: [`GpuWorld::sync`]
+    /// does that.
+    pub fn step(&mut self, n: u64) {
+        for _ in 0..n {
+            let c = self.host.port_constants_ahead(self.pending);
+            self.gpu.queue.write_buffer(&self.params, 0, bytemuck::cast_slice(&params(&c, self.host.description())));
+            let mut encoder = self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("mpca step") });
+            // The blocks processed are the last step's.
+            encoder.clear_buffer(&self.counters, 40, Some(4));
+            {
+                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("mpca step"), timestamp_writes: None });
+                pass.set_pipeline(&self.pipeline);
+                pass.set_bind_group(0, &self.groups[self.current], &[]);
+                pass.dispatch_workgroups(self.dispatch[0], self.dispatch[1], 1);
+            }
+            self.gpu.queue.submit([encoder.finish()]);
+            self.current = 1 - self.current;
+            self.pending += 1;
+        }
+    }
+
+    /// Brings the world down from the GPU into its CPU copy, and returns
+    /// that: its hash, statistics and snapshot image are the GPU world's.
+    pub fn sync(&mut self) -> &World {
+        if self.pending > 0 {
+            let occupancy = self.read(&self.occupancy[self.current]);
+            let velocity = self.read(&self.velocity[self.current]);
+            let counters: Vec<u32> = bytemuck::cast_slice(&self.read(&self.counters)).to_vec();
+            let p = self.host.port_planes();
+            let bytes = bytemuck::cast_slice_mut::<u64, u8>(p.occupancy);
+            let n = bytes.len();
+            bytes.copy_from_slice(&occupancy[..n]);
+            let n = p.velocity.len();
+            p.velocity.copy_from_slice(&velocity[..n]);
+            let wide = |i: usize| u64::from(counters[i]) | u64::from(counters[i + 1]) << 32;
+            self.host.port_count_steps(&StepCounts {
+                steps: self.pending,
+                collisions: wide(0),
+                clamps: wide(2),
+                clamp_energy: if counters[11] != 0 { u64::MAX } else { wide(4) },
+                displaced: wide(6),
+                exited: wide(8),
+                blocks_processed: u64::from(counters[10]),
+            });
+            // Counted into the CPU copy: the GPU's start again from zero.
+            self.gpu.queue.write_buffer(&self.counters, 0, &[0u8; 4 * COUNTERS]);
+            self.pending = 0;
+        }
+        &self.host
+    }
+
+    /// The contents of `buffer`, read back (waits for the GPU).
+    fn read(&self, buffer: &wgpu::Buffer) -> Vec<u8> {
+        let device = &self.gpu.device;
+        let size = buffer.size();
+        let staging = device.create_buffer(&wgpu::BufferDescriptor { label: Some("read back"), size, usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST, mapped_at_creation: false });
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("read back") });
+        encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, size);
+        self.gpu.queue.submit([encoder.finish()]);
+        staging.slice(..).map_async(wgpu::MapMode::Read, |r| r.expect("mapping a read-back buffer"));
+        device.poll(wgpu::PollType::Wait { submission_index: None, timeout: None }).expect("waiting for the GPU");
+        let bytes = staging.slice(..).get_mapped_range().expect("a mapped read-back buffer").to_vec();
+        staging.unmap();
+        bytes
+    }
+}
+
+/// The shader's parameters for a step with constants `c` (`step2d.wgsl`).
+fn params(c: &StepConstants, d: &Description) -> [u32; 16] {
+    let lo = |x: u64| x as u32;
+    let hi = |x: u64| (x >> 32) as u32;
+    let (nx, ny) = (d.size[0], d.size[1]);
+    [
+        lo(c.key),
+        hi(c.key),
+        lo(c.gamma),
+        hi(c.gamma),
+        lo(c.stride),
+        hi(c.stride),
+        nx,
+        ny,
+        2 * nx.div_ceil(64),
+        (c.step & 1) as u32,
+        c.restitution as u32,
+        c.unit as u32,
+        c.energy.0,
+        c.energy.1 as u32,
+        0,
+        0,
+    ]
+}
