@@ -17,6 +17,23 @@
 //! description that needs any other part is refused when the world is
 //! made, as a CPU build without that part refuses it
 //! ([`mpca::Error::FeatureDisabled`]).
+//!
+//! ```
+//! use mpca::{Description, WorldBox};
+//!
+//! # fn main() -> Result<(), mpca_gpu::Error> {
+//! let mut world = WorldBox::new(&Description::new_2d(64, 64))?;
+//! world.add_particle([3, 4, 0], [0.5, 0.25, 0.0])?;
+//! world.add_particle([4, 4, 0], [-0.5, 0.0, 0.0])?;
+//! let gpu = mpca_gpu::Gpu::new()?; // or Gpu::from_device(device, queue)
+//! let mut on_gpu = mpca_gpu::GpuWorld::new(&gpu, &world)?; // a copy
+//! on_gpu.step(100); // nothing read back
+//! world.step(100);
+//! let synced = on_gpu.sync(); // an mpca::World: hash, stats, save
+//! assert_eq!(synced.state_hash(), world.state_hash());
+//! # Ok(())
+//! # }
+//! ```
 
 use mpca::port::{StepCounts, StepConstants};
 use mpca::{Boundary, Collisions, Description, Identity, Method, Quantization, World, WorldBox};

@@ -284,10 +284,23 @@ pub fn size_scenes() -> [Scene; 4] {
 /// gas over the whole of a periodic 1024 x 1024 world, about 315,000
 /// particles.
 pub fn wide_gas() -> Scene {
-    let mut desc = Description::new_2d(1024, 1024);
+    full_gas("gas-1024-full", 1024, 50)
+}
+
+/// The aggregation gas over the whole of a periodic `n x n` world (density
+/// 0.3, e = 0.5), `steps` steps: [`wide_gas`] at 1024, and the GPU
+/// backend's benchmark and tests at other sizes (issue 29).
+pub fn full_gas(name: &'static str, n: u32, steps: u64) -> Scene {
+    let mut desc = Description::new_2d(n, n);
     desc.restitution = 0.5;
     desc.seed = 43;
-    Scene { name: "gas-1024-full", section: "-", desc, steps: 50, paper_seconds: f64::NAN, setup: |w| fill_gas(w, 1024, 1024) }
+    Scene { name, section: "-", desc, steps, paper_seconds: f64::NAN, setup: fill_whole }
+}
+
+/// [`fill_gas`] over the whole world.
+fn fill_whole(w: &mut World) -> Result<(), Error> {
+    let [nx, ny, _] = w.description().size;
+    fill_gas(w, nx, ny)
 }
 
 /// The elastic 8-bit box of M1b's test and report row: 128 x 128 cells with
