@@ -11,12 +11,13 @@
 //! planes and the counters down into it, and from there come the hash, the
 //! statistics and the snapshot image.
 //!
-//! This version runs the 2D rule with 8-bit velocities on periodic faces:
-//! collisions (M5.2, one mass, any restitution), both drift rules (M5.3)
-//! and the exact-fast assignment (M5.6) — the gas the benchmark runs. A
-//! description that needs any other part is refused when the world is
-//! made, as a CPU build without that part refuses it
-//! ([`mpca::Error::FeatureDisabled`]).
+//! This version runs the 2D rule with 8-bit velocities and one mass on any
+//! faces: the uniform force (M5.1), collisions (M5.2, any restitution),
+//! both drift rules (M5.3), reflection off walls (M5.4), the exact-fast
+//! assignment (M5.6) and exits through open faces: the paper's aggregation
+//! and cluster scenes and the benchmark's gas. A description that needs any
+//! other part is refused when the world is made, as a CPU build without
+//! that part refuses it ([`mpca::Error::FeatureDisabled`]).
 //!
 //! ```
 //! use mpca::{Description, WorldBox};
@@ -102,14 +103,12 @@ impl Gpu {
 
 /// Why this backend cannot run a description: `None` where it can.
 pub fn unsupported(d: &Description) -> Option<&'static str> {
-    let periodic = (0..2).all(|k| d.boundary[k] == [Boundary::Periodic; 2]);
-    let checks: [(bool, &'static str); 13] = [
+    let checks: [(bool, &'static str); 12] = [
         (d.dim == 2, "3D worlds"),
         (d.quantization == Quantization::Bits8, "16-bit velocities"),
-        (periodic, "faces that are not periodic"),
         (!d.per_particle_mass, "per-particle masses"),
         (!d.obstacles, "obstacles"),
-        (!(d.forces.uniform || d.forces.field || d.forces.potential || d.forces.vortex), "forces"),
+        (!(d.forces.field || d.forces.potential || d.forces.vortex), "force fields, potentials and the vortex"),
         (d.drag.rate == 0.0, "flow drag"),
         (d.method == Method::ExactFast, "an assignment other than exact-fast"),
         (d.collisions == Collisions::Paper, "speed-limited collisions"),
@@ -204,7 +203,7 @@ impl GpuWorld {
         let occupancy = [buffer("occupancy 0", &occupancy), buffer("occupancy 1", &occupancy)];
         let velocity = [buffer("velocity 0", &velocity), buffer("velocity 1", &velocity)];
         let counters = buffer("counters", &[0u8; 4 * COUNTERS]);
-        let params = buffer("params", &[0u8; 4 * 16]);
+        let params = buffer("params", &[0u8; 4 * PARAMS]);
         let tables = buffer("tables", bytemuck::cast_slice(&tables(mpca::port::move_table_8(desc.drift))));
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some("step2d.wgsl"), source: wgpu::ShaderSource::Wgsl(include_str!("step2d.wgsl").into()) });
         let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
@@ -235,7 +234,9 @@ impl GpuWorld {
             counters,
             groups,
             current: 0,
-            dispatch: [words.div_ceil(64), ny / 2],
+            // At offset 1 a face that is not periodic has a half block
+            // more (the shader skips the row where it has not).
+            dispatch: [words.div_ceil(64), ny / 2 + 1],
         })
     }
 
@@ -306,11 +307,25 @@ impl GpuWorld {
     }
 }
 
+/// The shader's parameters (`step2d.wgsl`).
+const PARAMS: usize = 24;
+
+/// A face as the shader reads it: 0 periodic, 1 wall, 2 open.
+fn face(b: Boundary) -> u32 {
+    match b {
+        Boundary::Periodic => 0,
+        Boundary::Wall => 1,
+        Boundary::Open => 2,
+    }
+}
+
 /// The shader's parameters for a step with constants `c` (`step2d.wgsl`).
-fn params(c: &StepConstants, d: &Description) -> [u32; 16] {
+fn params(c: &StepConstants, d: &Description) -> [u32; PARAMS] {
     let lo = |x: u64| x as u32;
     let hi = |x: u64| (x >> 32) as u32;
     let (nx, ny) = (d.size[0], d.size[1]);
+    let faces = face(d.boundary[0][0]) | face(d.boundary[0][1]) << 2 | face(d.boundary[1][0]) << 4 | face(d.boundary[1][1]) << 6;
+    let g = c.push.map(|g| g as u64);
     [
         lo(c.key),
         hi(c.key),
@@ -326,7 +341,15 @@ fn params(c: &StepConstants, d: &Description) -> [u32; 16] {
         c.unit as u32,
         c.energy.0,
         c.energy.1 as u32,
-        0,
+        faces,
+        c.wall_restitution as u32,
+        lo(g[0]),
+        hi(g[0]),
+        lo(g[1]),
+        hi(g[1]),
+        lo(g[2]),
+        hi(g[2]),
+        u32::from(c.push != [0; 3]),
         0,
     ]
 }

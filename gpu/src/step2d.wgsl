@@ -1,5 +1,5 @@
-// The local map of M5 on the 2D blocks of one step, for 8-bit storage, as
-// docs/model.md states it (M1c, M3, M5, M8). One invocation owns one
+// The local map of M5 on the 2D blocks of one step, for 8-bit storage and
+// one mass, as docs/model.md states it (M1c, M3, M4, M5, M8). One invocation owns one
 // 32-cell word of the occupancy in each of the two domain rows of a row of
 // blocks, and the velocities of those cells: it processes every block that
 // touches them (at offset 1 the two blocks that straddle its edges are also
@@ -12,7 +12,10 @@
 
 // params: 0-1 key, 2-3 gamma, 4-5 stride, 6 nx, 7 ny, 8 u32 words a row of
 // the occupancy, 9 offset, 10 restitution (Q16), 11 unit W, 12-13 the
-// clamp's energy factor (significand, exponent).
+// clamp's energy factor (significand, exponent), 14 the faces (2 bits each:
+// x low, x high, y low, y high; 0 periodic, 1 wall, 2 open), 15 the walls'
+// restitution (Q16), 16-21 the uniform push G (x, y, z as 64-bit pairs),
+// 22 whether G is not 0.
 @group(0) @binding(0) var<storage, read> params: array<u32>;
 // tables: 0..256 M5.3 move limits; 256..2304 the turns of M5.2 (cos, sin
 // as i32); 2304..3600 per 2D key its assignments (start | count << 16,
@@ -229,6 +232,7 @@ struct Counts {
     saturated: bool,
     displaced: u32,
     processed: u32,
+    exited: u32,
 }
 
 // M5.5: x clamped to the unit speed, counted.
@@ -272,19 +276,64 @@ struct Block {
     v: array<vec2<i32>, 4>,
 }
 
+// Where a block lies (M3, M4): its cells beyond a wall face (with their
+// normals in Q30) and beyond an open one.
+struct Site {
+    wall: u32,
+    open: u32,
+    normal: array<vec2<i32>, 4>,
+}
+
 const PAIR_A = array<u32, 6>(0u, 0u, 0u, 1u, 1u, 2u);
 const PAIR_B = array<u32, 6>(1u, 2u, 3u, 2u, 3u, 3u);
 const PLACE = array<u32, 4>(1u, 6u, 36u, 216u);
+// round(2^30 / sqrt(2)): the diagonal's components in Q30 (M1c).
+const DIAGONAL: i32 = 759250125;
 
-// M5.2 on the block's pair: eqs. 7-8 with R a turn of 1,024 (one mass),
-// both clamped, then both rounded (M1).
-fn collide(b: ptr<function, Block>, a: u32, c: u32, s: ptr<function, Stream>, counts: ptr<function, Counts>) {
+// The face of axis k (0 x, 1 y) on its high side or low: 0 periodic, 1
+// wall, 2 open.
+fn face(k: u32, high: bool) -> u32 {
+    return params[14] >> (4u * k + select(0u, 2u, high)) & 3u;
+}
+
+// A working velocity and the push G added, brought below 2^30 with its
+// direction kept (M1c's fit): G's z counts in the shift, as on the CPU.
+fn pushed(x: vec2<i32>) -> vec2<i32> {
+    var sum: array<vec2<u32>, 3>;
+    var m = 0u;
+    var top = 0u;
+    for (var k = 0u; k < 3u; k++) {
+        var xk = vec2<u32>(0u, 0u);
+        if k < 2u {
+            xk = vec2<u32>(bitcast<u32>(x[k]), select(0u, 0xffffffffu, x[k] < 0));
+        }
+        sum[k] = add64(xk, vec2<u32>(params[16u + 2u * k], params[17u + 2u * k]));
+        var magnitude = sum[k];
+        if (magnitude.y >> 31u) != 0u {
+            magnitude = add64(~magnitude, vec2<u32>(1u, 0u));
+        }
+        top = max(top, bitlen64(magnitude));
+    }
+    let shift = max(top, 30u) - 30u;
+    var out: vec2<i32>;
+    for (var k = 0u; k < 2u; k++) {
+        if shift == 0u {
+            out[k] = bitcast<i32>(sum[k].x);
+        } else {
+            out[k] = bitcast<i32>((sum[k].x >> shift) | (sum[k].y << (32u - shift)));
+        }
+    }
+    return out;
+}
+
+// M5.2 on the pair (a, c) with working velocities xa, xc: eqs. 7-8 with R
+// a turn of 1,024 (one mass), both clamped. False where the pair has one
+// velocity within the speed limit (nothing drawn, nothing changed).
+fn collide(xa: vec2<i32>, xc: vec2<i32>, out: ptr<function, array<vec2<i32>, 2>>, s: ptr<function, Stream>, counts: ptr<function, Counts>) -> bool {
     (*counts).collisions += 1u;
-    let xa = (*b).v[a] << vec2<u32>(16u);
-    let xc = (*b).v[c] << vec2<u32>(16u);
     let unit = bitcast<i32>(params[11]);
     if all(xa == xc) && !lt64(mul32(u32(unit), u32(unit)), sq2(xa)) {
-        return;
+        return false;
     }
     let d = xa - xc;
     let j = bits(s, 10u);
@@ -300,14 +349,70 @@ fn collide(b: ptr<function, Block>, a: u32, c: u32, s: ptr<function, Stream>, co
         na[k] = v0 + mulq(u, 32768, 16u);
         nc[k] = xa[k] + xc[k] - na[k];
     }
-    na = clamp_speed(na, counts);
-    nc = clamp_speed(nc, counts);
-    (*b).v[a] = round_velocity(na, s);
-    (*b).v[c] = round_velocity(nc, s);
+    (*out)[0] = clamp_speed(na, counts);
+    (*out)[1] = clamp_speed(nc, counts);
+    return true;
 }
 
-// M5.3: the axes each particle wants to cross, two bits a cell.
-fn desire(b: ptr<function, Block>, s: ptr<function, Stream>) -> u32 {
+// M5.1 on every particle (where G is not 0), M5.2 on the block's pair,
+// then M1 for every velocity they changed, in cell order.
+fn change(b: ptr<function, Block>, s: ptr<function, Stream>, counts: ptr<function, Counts>) {
+    var x: array<vec2<i32>, 4>;
+    var changed = 0u;
+    for (var c = 0u; c < 4u; c++) {
+        x[c] = (*b).v[c] << vec2<u32>(16u);
+        if params[22] != 0u && ((*b).occ >> c & 1u) != 0u {
+            x[c] = clamp_speed(pushed(x[c]), counts);
+            changed |= 1u << c;
+        }
+    }
+    // M5.2's pair, the block's first draw.
+    if ((*b).occ & ((*b).occ - 1u)) != 0u {
+        let p = below(s, 6u);
+        let a = PAIR_A[p];
+        let c = PAIR_B[p];
+        var out: array<vec2<i32>, 2>;
+        if ((*b).occ >> a & (*b).occ >> c & 1u) != 0u && collide(x[a], x[c], &out, s, counts) {
+            x[a] = out[0];
+            x[c] = out[1];
+            changed |= (1u << a) | (1u << c);
+        }
+    }
+    for (var c = 0u; c < 4u; c++) {
+        if (changed >> c & 1u) != 0u {
+            (*b).v[c] = round_velocity(x[c], s);
+        }
+    }
+}
+
+// M5.4 off a wall: eq. 9 with the wall's normal n (Q30) and restitution,
+// in fine units, then the clamp and M1. A particle asks for a wall cell
+// only moving into it (N.v < 0).
+fn reflect(q: vec2<i32>, n: vec2<i32>, s: ptr<function, Stream>, counts: ptr<function, Counts>) -> vec2<i32> {
+    let x = q << vec2<u32>(16u);
+    // The exact dot product, 64 bits.
+    var dot = vec2<u32>(0u, 0u);
+    for (var k = 0; k < 2; k++) {
+        var p = mul32(u32(abs(x[k])), u32(abs(n[k])));
+        if (x[k] < 0) != (n[k] < 0) {
+            p = add64(~p, vec2<u32>(1u, 0u));
+        }
+        dot = add64(dot, p);
+    }
+    var y = x;
+    if (dot.y >> 31u) != 0u {
+        // dot >> 30 fits 32 bits: |x| < 2^28, |n| <= 2^30.
+        let d = bitcast<i32>((dot.x >> 30u) | (dot.y << 2u));
+        let sigma = mulq(d, 65536 + bitcast<i32>(params[15]), 16u);
+        for (var k = 0; k < 2; k++) {
+            y[k] = clamp(x[k] - mulq(sigma, n[k], 30u), -(1 << 30u), 1 << 30u);
+        }
+    }
+    return round_velocity(clamp_speed(y, counts), s);
+}
+
+// M5.3 with M5.4: the axes each particle wants to cross, two bits a cell.
+fn desire(b: ptr<function, Block>, site: ptr<function, Site>, s: ptr<function, Stream>, counts: ptr<function, Counts>) -> u32 {
     var inward = 0u;
     for (var c = 0u; c < 4u; c++) {
         if ((*b).occ >> c & 1u) == 0u {
@@ -332,19 +437,26 @@ fn desire(b: ptr<function, Block>, s: ptr<function, Stream>) -> u32 {
         if (inward >> i & 1u) == 0u {
             continue;
         }
-        let q = (*b).v[i / 2u][i % 2u];
+        let c = i / 2u;
+        let q = (*b).v[c][i % 2u];
         let high = select(bytes.y, bytes.x, i < 4u) >> (8u * (i % 4u)) & 0xffu;
         let limit = tables[u32(q) & 0xffu];
         let top = limit >> 8u;
         if high < top || (high == top && bits(s, 8u) <= (limit & 0xffu)) {
             want |= 1u << i;
         }
+        // M5.4 once both axes of the cell are decided.
+        let m = want >> (2u * c) & 3u;
+        if (inward >> (i + 1u) & select(1u, 0u, i % 2u == 1u)) == 0u && m != 0u && ((*site).wall >> (c ^ m) & 1u) != 0u {
+            (*b).v[c] = reflect((*b).v[c], (*site).normal[c ^ m], s, counts);
+            want &= ~(3u << (2u * c));
+        }
     }
     return want;
 }
 
 // M5.6, exact-fast: the cell each particle goes to, 2 bits a cell.
-fn assign(b: ptr<function, Block>, want: u32, s: ptr<function, Stream>, counts: ptr<function, Counts>) -> u32 {
+fn assign(b: ptr<function, Block>, blocked: u32, want: u32, s: ptr<function, Stream>, counts: ptr<function, Counts>) -> u32 {
     let occ = (*b).occ;
     if want == 0u {
         return 0xe4u; // everyone stays: cell c to c
@@ -357,6 +469,8 @@ fn assign(b: ptr<function, Block>, want: u32, s: ptr<function, Stream>, counts: 
     for (var c = 0u; c < 4u; c++) {
         if (occ >> c & 1u) != 0u {
             key += PLACE[c] * (2u + (want >> (2u * c) & 3u));
+        } else if (blocked >> c & 1u) != 0u {
+            key += PLACE[c];
         }
     }
     let span = tables[KEYS_AT + key];
@@ -390,31 +504,77 @@ fn velocity(x: u32, y: u32) -> vec2<i32> {
     return vec2<i32>(i32(half << 24u) >> 24u, i32(half << 16u) >> 24u);
 }
 
+// A raw coordinate along axis k of n cells (one cell beyond a face at
+// most) resolved (M4): x = the cell inside, or 0 beyond a wall (kind 1) or
+// an open face (kind 2), with the inward normal's component for a wall.
+struct Resolved {
+    at: u32,
+    kind: u32,
+    inward: i32,
+}
+
+fn resolve(raw: i32, k: u32, n: u32) -> Resolved {
+    if raw >= 0 && raw < i32(n) {
+        return Resolved(u32(raw), 0u, 0);
+    }
+    let high = raw >= i32(n);
+    let f = face(k, high);
+    if f == 0u {
+        return Resolved(select(n - 1u, 0u, high), 0u, 0);
+    }
+    return Resolved(0u, f, select(1, -1, high));
+}
+
 @compute @workgroup_size(64)
 fn step_2d(@builtin(global_invocation_id) id: vec3<u32>) {
     let nx = params[6];
     let ny = params[7];
     let row_u32 = params[8];
     let o = params[9];
+    // M3: per axis the first block's lowest cell and the block count.
+    let periodic = vec2<bool>(face(0u, false) == 0u, face(1u, false) == 0u);
+    var first = vec2<i32>(0, 0);
+    var blocks = vec2<u32>(nx / 2u, ny / 2u);
+    for (var k = 0u; k < 2u; k++) {
+        if o == 1u {
+            first[k] = select(-1, 1, periodic[k]);
+            blocks[k] += select(1u, 0u, periodic[k]);
+        }
+    }
     let w = id.x;
     let r = id.y;
-    if w * 32u >= nx || r >= ny / 2u {
+    if w * 32u >= nx || r >= blocks.y {
         return;
     }
-    let ys = array<u32, 2>(2u * r + o, (2u * r + o + 1u) % ny);
+    // The block row's two domain rows, each inside or beyond a face.
+    let y0 = first.y + 2 * i32(r);
+    let rows = array<Resolved, 2>(resolve(y0, 1u, ny), resolve(y0 + 1, 1u, ny));
     let lo = 32u * w;
     let hi = min(lo + 32u, nx);
     // Nothing to do where neither row holds a particle in the word or
     // beside it.
-    var near = occ_in[ys[0] * row_u32 + w] | occ_in[ys[1] * row_u32 + w];
-    if o == 1u {
-        let before = (lo + nx - 1u) % nx;
-        let after = hi % nx;
-        near |= occupied(before, ys[0]) | occupied(before, ys[1]) | occupied(after, ys[0]) | occupied(after, ys[1]);
+    var near = 0u;
+    for (var row = 0u; row < 2u; row++) {
+        if rows[row].kind == 0u {
+            near |= occ_in[rows[row].at * row_u32 + w];
+            if o == 1u {
+                let before = resolve(i32(lo) - 1, 0u, nx);
+                let after = resolve(i32(hi), 0u, nx);
+                if before.kind == 0u {
+                    near |= occupied(before.at, rows[row].at);
+                }
+                if after.kind == 0u {
+                    near |= occupied(after.at, rows[row].at);
+                }
+            }
+        }
     }
     if near == 0u {
-        occ_out[ys[0] * row_u32 + w] = 0u;
-        occ_out[ys[1] * row_u32 + w] = 0u;
+        for (var row = 0u; row < 2u; row++) {
+            if rows[row].kind == 0u {
+                occ_out[rows[row].at * row_u32 + w] = 0u;
+            }
+        }
         return;
     }
     var out_occ = array<u32, 2>(0u, 0u);
@@ -423,56 +583,74 @@ fn step_2d(@builtin(global_invocation_id) id: vec3<u32>) {
         out_vel[0][i] = 0u;
         out_vel[1][i] = 0u;
     }
-    var counts = Counts(0u, 0u, vec2<u32>(0u, 0u), false, 0u, 0u);
-    let blocks_x = nx / 2u;
-    let first_bx = select(16u * w, 16u * w + blocks_x - 1u, o == 1u);
-    // At offset 1 the block before the word (the one that wraps round x,
-    // for the first word) is one of the word's own where a row has 16
-    // blocks or fewer: each once.
-    let count = min(select(min(16u, blocks_x - 16u * w), min(17u, blocks_x - 16u * w + 1u), o == 1u), blocks_x);
-    for (var j = 0u; j < count; j++) {
-        let bx = (first_bx + j) % blocks_x;
-        let x0 = 2u * bx + o;
-        let xs = array<u32, 2>(x0, (x0 + 1u) % nx);
+    var counts = Counts(0u, 0u, vec2<u32>(0u, 0u), false, 0u, 0u, 0u);
+    // The blocks with a cell in [lo, hi): x0 + 1 >= lo and x0 < hi.
+    let bx_lo = (i32(lo) - first.x) >> 1u;
+    let bx_hi = (i32(hi) - 1 - first.x) >> 1u;
+    for (var bxi = bx_lo; bxi <= bx_hi; bxi++) {
+        // The block before the first cell, on a periodic axis, is the one
+        // that wraps round; where it is also one of the word's own (a row
+        // of one word) it is taken once.
+        var bx = bxi;
+        if bx < 0 {
+            if bx_hi >= i32(blocks.x) - 1 {
+                continue;
+            }
+            bx += i32(blocks.x);
+        }
+        if bx >= i32(blocks.x) {
+            continue;
+        }
+        let x0 = first.x + 2 * bx;
+        let cols = array<Resolved, 2>(resolve(x0, 0u, nx), resolve(x0 + 1, 0u, nx));
         var b: Block;
+        var site: Site;
         b.occ = 0u;
+        site.wall = 0u;
+        site.open = 0u;
         for (var c = 0u; c < 4u; c++) {
-            let x = xs[c & 1u];
-            let y = ys[c >> 1u];
-            if occupied(x, y) != 0u {
-                b.occ |= 1u << c;
-                b.v[c] = velocity(x, y);
+            let col = cols[c & 1u];
+            let row = rows[c >> 1u];
+            b.v[c] = vec2<i32>(0, 0);
+            site.normal[c] = vec2<i32>(0, 0);
+            if col.kind == 0u && row.kind == 0u {
+                if occupied(col.at, row.at) != 0u {
+                    b.occ |= 1u << c;
+                    b.v[c] = velocity(col.at, row.at);
+                }
+            } else if col.kind == 1u || row.kind == 1u {
+                // A corner beyond a wall and an open face is a wall; its
+                // normal is the sum of the walls' inward normals, made unit.
+                site.wall |= 1u << c;
+                let n = vec2<i32>(select(0, col.inward, col.kind == 1u), select(0, row.inward, row.kind == 1u));
+                site.normal[c] = n * select(1 << 30u, DIAGONAL, n.x != 0 && n.y != 0);
             } else {
-                b.v[c] = vec2<i32>(0, 0);
+                site.open |= 1u << c;
             }
         }
         if b.occ == 0u {
             continue;
         }
-        var block_counts = Counts(0u, 0u, vec2<u32>(0u, 0u), false, 0u, 1u);
-        let index = bx + blocks_x * r;
+        var block_counts = Counts(0u, 0u, vec2<u32>(0u, 0u), false, 0u, 1u, 0u);
+        let index = u32(bx) + blocks.x * r;
         var s: Stream;
         s.counter = add64(vec2<u32>(params[0], params[1]), mul64(vec2<u32>(params[4], params[5]), vec2<u32>(index, 0u)));
         s.gamma = vec2<u32>(params[2], params[3]);
         s.pool = vec2<u32>(0u, 0u);
         s.left = 0u;
-        // M5.2's pair, the block's first draw.
-        if (b.occ & (b.occ - 1u)) != 0u {
-            let p = below(&s, 6u);
-            let a = PAIR_A[p];
-            let c = PAIR_B[p];
-            if (b.occ >> a & b.occ >> c & 1u) != 0u {
-                collide(&b, a, c, &s, &block_counts);
-            }
-        }
-        let want = desire(&b, &s);
-        let targets = assign(&b, want, &s, &block_counts);
+        change(&b, &s, &block_counts);
+        let want = desire(&b, &site, &s, &block_counts);
+        let targets = assign(&b, site.wall, want, &s, &block_counts);
         for (var c = 0u; c < 4u; c++) {
             if (b.occ >> c & 1u) == 0u {
                 continue;
             }
             let t = targets >> (2u * c) & 3u;
-            let x = xs[t & 1u];
+            if (site.open >> t & 1u) != 0u {
+                block_counts.exited += 1u; // M4: through an open face
+                continue;
+            }
+            let x = cols[t & 1u].at;
             if x < lo || x >= hi {
                 continue;
             }
@@ -482,19 +660,25 @@ fn step_2d(@builtin(global_invocation_id) id: vec3<u32>) {
             let byte_pair = (u32(b.v[c].x) & 0xffu) | (u32(b.v[c].y) & 0xffu) << 8u;
             out_vel[row][k] |= byte_pair << (16u * (x & 1u));
         }
-        if x0 >= lo && x0 < hi {
+        // Counted by the invocation that owns the block's first cell inside.
+        let owner = u32(max(x0, 0));
+        if owner >= lo && owner < hi {
             counts.collisions += block_counts.collisions;
             counts.clamps += block_counts.clamps;
             let total = add64(counts.energy, block_counts.energy);
             counts.saturated = counts.saturated || block_counts.saturated || lt64(total, block_counts.energy);
             counts.energy = total;
             counts.displaced += block_counts.displaced;
+            counts.exited += block_counts.exited;
             counts.processed += 1u;
         }
     }
     for (var row = 0u; row < 2u; row++) {
-        occ_out[ys[row] * row_u32 + w] = out_occ[row];
-        let base = (ys[row] * nx + lo) >> 1u;
+        if rows[row].kind != 0u {
+            continue;
+        }
+        occ_out[rows[row].at * row_u32 + w] = out_occ[row];
+        let base = (rows[row].at * nx + lo) >> 1u;
         for (var k = 0u; k < (hi - lo) / 2u; k++) {
             vel_out[base + k] = out_vel[row][k];
         }
@@ -506,6 +690,7 @@ fn step_2d(@builtin(global_invocation_id) id: vec3<u32>) {
         atomicOr(&counters[11], 1u);
     }
     add_count(6u, counts.displaced);
+    add_count(8u, counts.exited);
     if counts.processed != 0u {
         atomicAdd(&counters[10], counts.processed);
     }

@@ -98,3 +98,47 @@ fn a_part_the_backend_does_not_run_is_refused() {
     assert!(matches!(GpuWorld::new(&gpu, &w), Err(mpca_gpu::Error::World(mpca::Error::FeatureDisabled))));
     assert_eq!(mpca_gpu::unsupported(w.description()), Some("contacts"));
 }
+
+#[test]
+fn the_papers_aggregation_scene_steps_as_on_the_cpu() {
+    // 4.1 as the paper ran it (800 steps, the paper's drift rule), compared
+    // every 100 steps.
+    let scene = mpca_tests::scenes::aggregation();
+    let mut memory = Vec::new();
+    let w = mpca_tests::scenes::build(&scene, &mut memory).unwrap();
+    same_worlds(w, scene.steps, 100);
+}
+
+#[test]
+fn walls_open_faces_and_gravity_step_as_on_the_cpu() {
+    // Every mix of wall, open and periodic axes, with and without a uniform
+    // force (large enough to clamp), at sizes whose half blocks cross words.
+    use mpca::Boundary::{Open, Periodic, Wall};
+    let faces = [[[Wall, Wall], [Wall, Wall]], [[Open, Open], [Wall, Wall]], [[Wall, Open], [Open, Wall]], [[Periodic, Periodic], [Wall, Open]], [[Open, Wall], [Periodic, Periodic]]];
+    for (i, f) in faces.into_iter().enumerate() {
+        for (nx, ny) in [(8, 6), (66, 34)] {
+            for gravity in [None, Some([0.02, -0.3, 0.5])] {
+                let mut w = gas(nx, ny, 0.5, 100 + i as u64, |d| {
+                    d.boundary[0] = f[0];
+                    d.boundary[1] = f[1];
+                    d.wall_restitution = 0.7;
+                    if let Some(g) = gravity {
+                        d.forces.uniform = true;
+                        d.gravity = g;
+                    }
+                });
+                same_worlds(&mut w, 16, 1);
+            }
+        }
+    }
+}
+
+#[test]
+fn the_papers_cluster_scene_steps_as_on_the_cpu() {
+    // 4.2 as the paper ran it: walls all round, e = 1, 130 steps.
+    let scene = mpca_tests::scenes::cluster();
+    let mut memory = Vec::new();
+    let w = mpca_tests::scenes::build(&scene, &mut memory).unwrap();
+    same_worlds(w, scene.steps, 10);
+}
+

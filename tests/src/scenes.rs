@@ -43,6 +43,7 @@ pub fn aggregation() -> Scene {
     Scene { name: "aggregation", section: "4.1", desc, steps: 800, paper_seconds: 800.0, setup: fill_aggregation }
 }
 
+/// The aggregation's gas over the whole world, whatever its size.
 fn fill_aggregation(w: &mut World) -> Result<(), Error> {
     let [nx, ny, _] = w.description().size;
     fill_gas(w, nx, ny)
@@ -294,13 +295,7 @@ pub fn full_gas(name: &'static str, n: u32, steps: u64) -> Scene {
     let mut desc = Description::new_2d(n, n);
     desc.restitution = 0.5;
     desc.seed = 43;
-    Scene { name, section: "-", desc, steps, paper_seconds: f64::NAN, setup: fill_whole }
-}
-
-/// [`fill_gas`] over the whole world.
-fn fill_whole(w: &mut World) -> Result<(), Error> {
-    let [nx, ny, _] = w.description().size;
-    fill_gas(w, nx, ny)
+    Scene { name, section: "-", desc, steps, paper_seconds: f64::NAN, setup: fill_aggregation }
 }
 
 /// The elastic 8-bit box of M1b's test and report row: 128 x 128 cells with

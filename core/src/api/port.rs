@@ -8,7 +8,7 @@
 //! world.
 
 use crate::api::desc::Drift;
-use crate::rules::fixed::{magnitude, parts};
+use crate::rules::fixed::{magnitude, parts, scaled, scaled_by};
 use crate::rules::quant::Quant;
 use crate::rules::rng::StepKey;
 use crate::step::convert_class;
@@ -28,8 +28,13 @@ pub struct StepConstants {
     pub gamma: u64,
     /// See `key`: `gamma` times the counters a block owns.
     pub stride: u64,
+    /// M5.1's uniform push `G` per axis in fine units, 0 where the force
+    /// is off (M1c).
+    pub push: [i64; 3],
     /// M5.2's restitution `E` in Q16.
     pub restitution: i32,
+    /// M5.4's restitution of the walls in Q16.
+    pub wall_restitution: i32,
     /// The world's unit speed `W` in fine units (M1c).
     pub unit: i32,
     /// Fine bits per quantum, `F` (M1c).
@@ -93,7 +98,9 @@ impl World {
             key,
             gamma,
             stride,
-            restitution: crate::rules::fixed::scaled(desc.restitution, 1.0, 16) as i32,
+            push: if desc.forces.uniform { desc.gravity.map(|g| scaled_by(desc.dt, g, s as u32, fine as i32)) } else { [0; 3] },
+            restitution: scaled(desc.restitution, 1.0, 16) as i32,
+            wall_restitution: scaled(desc.wall_restitution, 1.0, 16) as i32,
             unit,
             fine,
             energy: (m as u32, e),
