@@ -55,10 +55,10 @@ fn main() {
             // The shader compiled and the buffers filled before the clock
             // starts: one step and a read-back first.
             g.step(1);
-            g.sync();
+            g.sync().expect("the GPU world syncs");
             let start = Instant::now();
             g.step(scene.steps);
-            g.sync();
+            g.sync().expect("the GPU world syncs");
             start.elapsed().as_secs_f64()
         }).collect());
         let one = time(scene, runs, &mut memory, &mut |w, n| w.step(n));

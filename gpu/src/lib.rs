@@ -8,8 +8,8 @@
 //! that the steps read and write in turn. A copy of the world on the CPU
 //! (an [`mpca::World`]) keeps what does not change in a step (the
 //! description) and what a step counts; [`GpuWorld::sync`] brings the
-//! planes and the counters down into it, and from there come the hash, the
-//! statistics and the snapshot image.
+//! planes and the counters down into it, which checks them, and from there
+//! come the hash, the statistics and the snapshot image.
 //!
 //! This version runs the 2D rule with 8-bit velocities and one mass on any
 //! faces: the uniform force (M5.1), collisions (M5.2, any restitution),
@@ -30,7 +30,7 @@
 //! let mut on_gpu = mpca_gpu::GpuWorld::new(&gpu, &world)?; // a copy
 //! on_gpu.step(100); // nothing read back
 //! world.step(100);
-//! let synced = on_gpu.sync(); // an mpca::World: hash, stats, save
+//! let synced = on_gpu.sync()?; // an mpca::World: hash, stats, save
 //! assert_eq!(synced.state_hash(), world.state_hash());
 //! # Ok(())
 //! # }
@@ -189,10 +189,8 @@ impl GpuWorld {
         let device = &gpu.device;
         let desc = *host.description();
         let (nx, ny) = (desc.size[0], desc.size[1]);
-        let (occupancy, velocity) = {
-            let p = host.port_planes();
-            (bytemuck::cast_slice::<u64, u8>(p.occupancy).to_vec(), p.velocity.to_vec())
-        };
+        let p = host.port_planes();
+        let (occupancy, velocity) = (bytemuck::cast_slice::<u64, u8>(p.occupancy).to_vec(), p.velocity.to_vec());
         let storage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
         let buffer = |label: &str, bytes: &[u8]| {
             // A buffer's size is a multiple of 4 bytes, at least 4.
@@ -263,19 +261,18 @@ impl GpuWorld {
 
     /// Brings the world down from the GPU into its CPU copy, and returns
     /// that: its hash, statistics and snapshot image are the GPU world's.
-    pub fn sync(&mut self) -> &World {
+    /// The CPU copy checks what it takes (`mpca::World::port_finish_steps`):
+    /// an error here is a fault of this backend, and leaves the copy as it
+    /// was at the last sync.
+    pub fn sync(&mut self) -> Result<&World, Error> {
         if self.pending > 0 {
-            let occupancy = self.read(&self.occupancy[self.current]);
-            let velocity = self.read(&self.velocity[self.current]);
+            let occupancy: Vec<u64> = self.read(&self.occupancy[self.current]).chunks_exact(8).map(|b| u64::from_le_bytes(b.try_into().expect("8 bytes"))).collect();
+            let mut velocity = self.read(&self.velocity[self.current]);
             let counters: Vec<u32> = bytemuck::cast_slice(&self.read(&self.counters)).to_vec();
-            let p = self.host.port_planes();
-            let bytes = bytemuck::cast_slice_mut::<u64, u8>(p.occupancy);
-            let n = bytes.len();
-            bytes.copy_from_slice(&occupancy[..n]);
-            let n = p.velocity.len();
-            p.velocity.copy_from_slice(&velocity[..n]);
+            // The buffer is padded to whole words.
+            velocity.truncate(self.host.port_planes().velocity.len());
             let wide = |i: usize| u64::from(counters[i]) | u64::from(counters[i + 1]) << 32;
-            self.host.port_count_steps(&StepCounts {
+            let counts = StepCounts {
                 steps: self.pending,
                 collisions: wide(0),
                 clamps: wide(2),
@@ -283,12 +280,13 @@ impl GpuWorld {
                 displaced: wide(6),
                 exited: wide(8),
                 blocks_processed: u64::from(counters[10]),
-            });
+            };
+            self.host.port_finish_steps(&occupancy, &velocity, &counts)?;
             // Counted into the CPU copy: the GPU's start again from zero.
             self.gpu.queue.write_buffer(&self.counters, 0, &[0u8; 4 * COUNTERS]);
             self.pending = 0;
         }
-        &self.host
+        Ok(&self.host)
     }
 
     /// The contents of `buffer`, read back (waits for the GPU).

@@ -53,7 +53,7 @@ fn same_worlds(cpu: &mut World, steps: u64, every: u64) {
         cpu.step(every);
         g.step(every);
         done += every;
-        let on_gpu = g.sync();
+        let on_gpu = g.sync().unwrap();
         assert_eq!(on_gpu.stats(), cpu.stats(), "step {done}: statistics");
         assert_eq!(on_gpu.state_hash(), cpu.state_hash(), "step {done}: hash");
         assert!(image(on_gpu) == image(cpu), "step {done}: image");
@@ -99,14 +99,17 @@ fn a_part_the_backend_does_not_run_is_refused() {
     assert_eq!(mpca_gpu::unsupported(w.description()), Some("contacts"));
 }
 
-#[test]
-fn the_papers_aggregation_scene_steps_as_on_the_cpu() {
-    // 4.1 as the paper ran it (800 steps, the paper's drift rule), compared
-    // every 100 steps.
-    let scene = mpca_tests::scenes::aggregation();
+/// A scene of the paper as the paper ran it, compared every `every` steps.
+fn same_scene(scene: mpca_tests::scenes::Scene, every: u64) {
     let mut memory = Vec::new();
     let w = mpca_tests::scenes::build(&scene, &mut memory).unwrap();
-    same_worlds(w, scene.steps, 100);
+    same_worlds(w, scene.steps, every);
+}
+
+#[test]
+fn the_papers_aggregation_scene_steps_as_on_the_cpu() {
+    // 4.1: 800 steps, the paper's drift rule, periodic.
+    same_scene(mpca_tests::scenes::aggregation(), 100);
 }
 
 #[test]
@@ -135,10 +138,52 @@ fn walls_open_faces_and_gravity_step_as_on_the_cpu() {
 
 #[test]
 fn the_papers_cluster_scene_steps_as_on_the_cpu() {
-    // 4.2 as the paper ran it: walls all round, e = 1, 130 steps.
-    let scene = mpca_tests::scenes::cluster();
-    let mut memory = Vec::new();
-    let w = mpca_tests::scenes::build(&scene, &mut memory).unwrap();
-    same_worlds(w, scene.steps, 10);
+    // 4.2: walls all round, e = 1, 130 steps.
+    same_scene(mpca_tests::scenes::cluster(), 10);
 }
 
+
+#[test]
+fn planes_that_are_not_a_world_are_refused_and_change_nothing() {
+    // mpca::World::port_finish_steps, which the sync goes through: each
+    // damaged plane is refused with the world's hash and statistics as
+    // they were; the planes as they are pass.
+    use mpca::port::StepCounts;
+    let mut w = gas(66, 6, 0.4, 3, |_| {});
+    let (occupancy, velocity) = {
+        let p = w.port_planes();
+        (p.occupancy.to_vec(), p.velocity.to_vec())
+    };
+    let (hash, stats) = (w.state_hash(), w.stats());
+    let one = StepCounts { steps: 1, ..StepCounts::default() };
+    let first = occupancy.iter().position(|&o| o != 0).unwrap();
+    let cell = 64 * first + occupancy[first].trailing_zeros() as usize;
+    let mut cases: Vec<(Vec<u64>, Vec<u8>, StepCounts, mpca::Error)> = Vec::new();
+    cases.push((occupancy[1..].to_vec(), velocity.clone(), one, mpca::Error::BadLength));
+    cases.push((occupancy.clone(), velocity[1..].to_vec(), one, mpca::Error::BadLength));
+    let mut beyond = occupancy.clone();
+    beyond[1] |= 1 << 63; // cell 127 of a 66-cell row
+    beyond[first] &= beyond[first] - 1;
+    cases.push((beyond, velocity.clone(), one, mpca::Error::ImageInvalid));
+    let mut fast = velocity.clone();
+    fast[2 * (cell % 64 + 66 * (first / 2))] = 0x80; // -128: beyond -127
+    cases.push((occupancy.clone(), fast, one, mpca::Error::ImageInvalid));
+    let mut lost = occupancy.clone();
+    lost[first] &= lost[first] - 1;
+    cases.push((lost.clone(), velocity.clone(), one, mpca::Error::ImageInvalid));
+    for (o, v, c, want) in cases {
+        assert_eq!(w.port_finish_steps(&o, &v, &c), Err(want));
+        assert_eq!((w.state_hash(), w.stats()), (hash, stats));
+    }
+    // One particle fewer is what one exit leaves.
+    w.port_finish_steps(&lost, &velocity, &StepCounts { steps: 1, exited: 1, ..StepCounts::default() }).unwrap();
+    assert_eq!(w.stats().particles, stats.particles - 1);
+    // A world whose particles carry a lifetime: the planes cannot say
+    // where it went.
+    let mut aged = gas(8, 8, 0.4, 3, |d| d.lifetimes = true);
+    let (o, v) = {
+        let p = aged.port_planes();
+        (p.occupancy.to_vec(), p.velocity.to_vec())
+    };
+    assert_eq!(aged.port_finish_steps(&o, &v, &one), Err(mpca::Error::NotEnabled));
+}

@@ -13,6 +13,7 @@ use crate::rules::quant::Quant;
 use crate::rules::rng::StepKey;
 use crate::step::convert_class;
 use crate::step::partition::Partition;
+use crate::api::error::Error;
 use crate::storage::world::{Counters, World};
 
 /// The integers one step of a world reads, converted from its description
@@ -48,7 +49,7 @@ pub struct StepConstants {
 }
 
 /// What steps run elsewhere counted (the fields of [`crate::Stats`] of the
-/// same names), handed back by [`World::port_count_steps`].
+/// same names), handed back by [`World::port_finish_steps`].
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct StepCounts {
     /// Steps run.
@@ -71,19 +72,19 @@ pub struct StepCounts {
 pub struct PortPlanes<'a> {
     /// One bit a cell, `row_words` 64-bit words a row of `nx` cells (the
     /// last padded with zeros), rows in `y + ny z` order.
-    pub occupancy: &'a mut [u64],
+    pub occupancy: &'a [u64],
     /// 64-bit words a row of the occupancy.
     pub row_words: usize,
     /// The stored velocity components, `dim` a cell in dense cell order,
     /// one byte each (8-bit worlds) or two (16-bit, little-endian). What an
     /// empty cell holds is never read.
-    pub velocity: &'a mut [u8],
+    pub velocity: &'a [u8],
 }
 
 impl World {
     /// The integers of the step `ahead` steps after the one this world
     /// takes next (M1c, M8): a backend that runs several steps before it
-    /// counts them into this world ([`World::port_count_steps`]) asks
+    /// counts them into this world ([`World::port_finish_steps`]) asks
     /// with the steps it has run.
     pub fn port_constants_ahead(&self, ahead: u64) -> StepConstants {
         let step = self.head.step.wrapping_add(ahead);
@@ -108,23 +109,77 @@ impl World {
         }
     }
 
-    /// The occupancy and velocity planes, to copy a world out or in. The
-    /// step's summaries of empty rows and words are marked "may hold a
-    /// particle" everywhere, so that whatever is written here, the next
-    /// step sweeps it (M3); the particle count is not changed.
-    pub fn port_planes(&mut self) -> PortPlanes<'_> {
-        let row_words = self.layout().row_words;
-        let (_, p) = self.planes::<u8>();
-        p.rows.fill(1);
-        p.words.fill(u64::MAX);
-        PortPlanes { occupancy: p.occupancy, row_words, velocity: p.velocity }
+    /// The occupancy and velocity planes, to copy a world out.
+    pub fn port_planes(&self) -> PortPlanes<'_> {
+        let l = self.layout();
+        PortPlanes { occupancy: self.plane(l.occupancy()), row_words: l.row_words, velocity: self.plane_bytes(l.velocity()) }
     }
 
-    /// Counts `c.steps` steps that ran elsewhere (the emitters and the
-    /// sweep of each) into this world: adds their counters, sets the last
-    /// step's processed and skipped blocks and advances the step number.
-    /// The occupancy must already be the one they left ([`World::port_planes`]).
-    pub fn port_count_steps(&mut self, c: &StepCounts) {
+    /// Takes the world `c.steps` steps that ran elsewhere left: its
+    /// occupancy and velocities as [`World::port_planes`] lays them out,
+    /// and what those steps counted (their counters added, the last step's
+    /// processed and skipped blocks set, the step number advanced).
+    ///
+    /// Refused, with the world unchanged: planes of the wrong length
+    /// (`BadLength`); a world whose particles carry more than a velocity
+    /// (masses, lifetimes, ids, ages or tags: `NotEnabled`, since the
+    /// planes do not say where those went); a bit set beyond a row's end, a
+    /// particle on an obstacle, a stored component beyond the storage's
+    /// range, or a particle count other than the world's less the exits
+    /// (`ImageInvalid`).
+    pub fn port_finish_steps(&mut self, occupancy: &[u64], velocity: &[u8], c: &StepCounts) -> Result<(), Error> {
+        let l = *self.layout();
+        let desc = self.head.desc;
+        if occupancy.len() * 8 != l.occupancy().len || velocity.len() != l.velocity().len {
+            return Err(Error::BadLength);
+        }
+        if desc.has_masses() || desc.lifetimes || desc.identity_planes().any() {
+            return Err(Error::NotEnabled);
+        }
+        let obstacle: &[u64] = self.plane(l.obstacle());
+        let padding = match l.n[0] % 64 {
+            0 => 0,
+            used => u64::MAX << used,
+        };
+        let wide = desc.quantization == crate::api::desc::Quantization::Bits16;
+        let limit = if wide { 32767 } else { 127 };
+        let dim = self.dim();
+        let mut count = 0u64;
+        for (i, &word) in occupancy.iter().enumerate() {
+            if i % l.row_words == l.row_words - 1 && word & padding != 0 || obstacle.get(i).is_some_and(|o| o & word != 0) {
+                return Err(Error::ImageInvalid);
+            }
+            count += u64::from(word.count_ones());
+            let mut bits = word;
+            while bits != 0 {
+                let x = (i % l.row_words) * 64 + bits.trailing_zeros() as usize;
+                bits &= bits - 1;
+                let cell = (i / l.row_words) * l.n[0] + x;
+                for k in 0..dim {
+                    let at = cell * dim + k;
+                    let q = if wide { i32::from(i16::from_le_bytes([velocity[2 * at], velocity[2 * at + 1]])) } else { i32::from(velocity[at] as i8) };
+                    if q.abs() > limit {
+                        return Err(Error::ImageInvalid);
+                    }
+                }
+            }
+        }
+        if Some(count) != self.head.counters.particles.checked_sub(c.exited) {
+            return Err(Error::ImageInvalid);
+        }
+        let (_, p) = self.planes::<u8>();
+        p.occupancy.copy_from_slice(occupancy);
+        p.velocity.copy_from_slice(velocity);
+        // The step's summaries of empty rows and words (M3): "may hold a
+        // particle" everywhere, so that the next step sweeps what came in.
+        p.rows.fill(1);
+        p.words.fill(u64::MAX);
+        self.count_steps(c);
+        Ok(())
+    }
+
+    /// [`World::port_finish_steps`]' counting, once its planes are in.
+    fn count_steps(&mut self, c: &StepCounts) {
         if c.steps == 0 {
             return;
         }
