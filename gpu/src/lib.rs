@@ -29,7 +29,10 @@
 //! let gpu = mpca_gpu::Gpu::new()?; // or Gpu::from_device(device, queue)
 //! let mut on_gpu = mpca_gpu::GpuWorld::new(&gpu, &world)?; // a copy
 //! on_gpu.step(100); // nothing read back
-//! world.step(100);
+//! let mut encoder = gpu.device.create_command_encoder(&Default::default());
+//! on_gpu.record(&mut encoder, 1); // or into an engine's frame
+//! gpu.queue.submit([encoder.finish()]);
+//! world.step(101);
 //! let synced = on_gpu.sync()?; // an mpca::World: hash, stats, save
 //! assert_eq!(synced.state_hash(), world.state_hash());
 //! # Ok(())
@@ -50,6 +53,9 @@ pub enum Error {
     NoAdapter(String),
     /// The adapter would not give a device.
     Device(String),
+    /// [`GpuWorld::sync`] found fewer steps run than were recorded: an
+    /// encoder that [`GpuWorld::record`] wrote to was not submitted.
+    Unsubmitted,
 }
 
 impl core::fmt::Display for Error {
@@ -58,6 +64,7 @@ impl core::fmt::Display for Error {
             Error::World(e) => write!(f, "{e}"),
             Error::NoAdapter(why) => write!(f, "no GPU adapter: {why}"),
             Error::Device(why) => write!(f, "the GPU adapter gave no device: {why}"),
+            Error::Unsubmitted => write!(f, "steps were recorded into an encoder that was not submitted"),
         }
     }
 }
@@ -150,8 +157,12 @@ fn tables(moves: &[u16; 256]) -> Vec<u32> {
 
 /// The counters buffer: pairs (low, high) of collisions, clamps, clamp
 /// energy, displaced, exited; the blocks processed in the step; a flag for
-/// a saturated clamp energy.
-const COUNTERS: usize = 12;
+/// a saturated clamp energy; the blocks processed in the last step; the
+/// number of the step the world takes next (low, high).
+const COUNTERS: usize = 15;
+/// The counters a sync takes into the CPU copy and clears: all but the
+/// step number.
+const COUNTED: usize = 13;
 
 /// A world stepped on the GPU, equal to the CPU's bit for bit.
 pub struct GpuWorld {
@@ -162,7 +173,9 @@ pub struct GpuWorld {
     /// Steps run on the GPU since the last sync.
     pending: u64,
     pipeline: wgpu::ComputePipeline,
-    params: wgpu::Buffer,
+    /// `end_step`: the last step's processed blocks, the step number.
+    end: wgpu::ComputePipeline,
+    end_group: wgpu::BindGroup,
     occupancy: [wgpu::Buffer; 2],
     velocity: [wgpu::Buffer; 2],
     counters: wgpu::Buffer,
@@ -200,17 +213,28 @@ impl GpuWorld {
         };
         let occupancy = [buffer("occupancy 0", &occupancy), buffer("occupancy 1", &occupancy)];
         let velocity = [buffer("velocity 0", &velocity), buffer("velocity 1", &velocity)];
-        let counters = buffer("counters", &[0u8; 4 * COUNTERS]);
-        let params = buffer("params", &[0u8; 4 * PARAMS]);
+        let mut start = [0u32; COUNTERS];
+        let step = host.stats().step;
+        (start[13], start[14]) = (step as u32, (step >> 32) as u32);
+        let counters = buffer("counters", bytemuck::cast_slice(&start));
+        let params = buffer("params", bytemuck::cast_slice(&params(&host.port_constants(), &desc)));
         let tables = buffer("tables", bytemuck::cast_slice(&tables(mpca::port::move_table_8(desc.drift))));
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some("step2d.wgsl"), source: wgpu::ShaderSource::Wgsl(include_str!("step2d.wgsl").into()) });
-        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("step 2D"),
-            layout: None,
-            module: &module,
-            entry_point: Some("step_2d"),
-            compilation_options: Default::default(),
-            cache: None,
+        let pipeline_of = |entry: &str| {
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(entry),
+                layout: None,
+                module: &module,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        };
+        let (pipeline, end) = (pipeline_of("step_2d"), pipeline_of("end_step"));
+        let end_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("end of step"),
+            layout: &end.get_bind_group_layout(0),
+            entries: &[wgpu::BindGroupEntry { binding: 6, resource: counters.as_entire_binding() }],
         });
         let layout = pipeline.get_bind_group_layout(0);
         let group = |from: usize| {
@@ -226,7 +250,8 @@ impl GpuWorld {
             host,
             pending: 0,
             pipeline,
-            params,
+            end,
+            end_group,
             occupancy,
             velocity,
             counters,
@@ -238,25 +263,34 @@ impl GpuWorld {
         })
     }
 
-    /// Runs `n` steps on the GPU. Nothing is read back: [`GpuWorld::sync`]
-    /// does that.
+    /// Runs `n` steps on the GPU: [`GpuWorld::record`] into an encoder of
+    /// its own, submitted. Nothing is read back: [`GpuWorld::sync`] does
+    /// that.
     pub fn step(&mut self, n: u64) {
+        let mut encoder = self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("mpca steps") });
+        self.record(&mut encoder, n);
+        self.gpu.queue.submit([encoder.finish()]);
+    }
+
+    /// Records `n` steps into the caller's `encoder` (an engine's frame),
+    /// as one compute pass: the steps run where the caller submits it, in
+    /// order with the rest of its work. Everything a step reads is on the
+    /// GPU already (the step number too), so recording writes nothing
+    /// through the queue. The encoder must be submitted before the next
+    /// [`GpuWorld::sync`], which otherwise says so
+    /// ([`Error::Unsubmitted`]).
+    pub fn record(&mut self, encoder: &mut wgpu::CommandEncoder, n: u64) {
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("mpca steps"), timestamp_writes: None });
         for _ in 0..n {
-            let c = self.host.port_constants_ahead(self.pending);
-            self.gpu.queue.write_buffer(&self.params, 0, bytemuck::cast_slice(&params(&c, self.host.description())));
-            let mut encoder = self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("mpca step") });
-            // The blocks processed are the last step's.
-            encoder.clear_buffer(&self.counters, 40, Some(4));
-            {
-                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("mpca step"), timestamp_writes: None });
-                pass.set_pipeline(&self.pipeline);
-                pass.set_bind_group(0, &self.groups[self.current], &[]);
-                pass.dispatch_workgroups(self.dispatch[0], self.dispatch[1], 1);
-            }
-            self.gpu.queue.submit([encoder.finish()]);
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(0, &self.groups[self.current], &[]);
+            pass.dispatch_workgroups(self.dispatch[0], self.dispatch[1], 1);
+            pass.set_pipeline(&self.end);
+            pass.set_bind_group(0, &self.end_group, &[]);
+            pass.dispatch_workgroups(1, 1, 1);
             self.current = 1 - self.current;
-            self.pending += 1;
         }
+        self.pending += n;
     }
 
     /// Brings the world down from the GPU into its CPU copy, and returns
@@ -272,6 +306,9 @@ impl GpuWorld {
             // The buffer is padded to whole words.
             velocity.truncate(self.host.port_planes().velocity.len());
             let wide = |i: usize| u64::from(counters[i]) | u64::from(counters[i + 1]) << 32;
+            if wide(13) != self.host.stats().step.wrapping_add(self.pending) {
+                return Err(Error::Unsubmitted);
+            }
             let counts = StepCounts {
                 steps: self.pending,
                 collisions: wide(0),
@@ -279,11 +316,11 @@ impl GpuWorld {
                 clamp_energy: if counters[11] != 0 { u64::MAX } else { wide(4) },
                 displaced: wide(6),
                 exited: wide(8),
-                blocks_processed: u64::from(counters[10]),
+                blocks_processed: u64::from(counters[12]),
             };
             self.host.port_finish_steps(&occupancy, &velocity, &counts)?;
             // Counted into the CPU copy: the GPU's start again from zero.
-            self.gpu.queue.write_buffer(&self.counters, 0, &[0u8; 4 * COUNTERS]);
+            self.gpu.queue.write_buffer(&self.counters, 0, &[0u8; 4 * COUNTED]);
             self.pending = 0;
         }
         Ok(&self.host)
@@ -317,7 +354,8 @@ fn face(b: Boundary) -> u32 {
     }
 }
 
-/// The shader's parameters for a step with constants `c` (`step2d.wgsl`).
+/// The shader's parameters, the same every step (`step2d.wgsl`), from
+/// the constants of any step `c`.
 fn params(c: &StepConstants, d: &Description) -> [u32; PARAMS] {
     let lo = |x: u64| x as u32;
     let hi = |x: u64| (x >> 32) as u32;
@@ -325,16 +363,16 @@ fn params(c: &StepConstants, d: &Description) -> [u32; PARAMS] {
     let faces = face(d.boundary[0][0]) | face(d.boundary[0][1]) << 2 | face(d.boundary[1][0]) << 4 | face(d.boundary[1][1]) << 6;
     let g = c.push.map(|g| g as u64);
     [
-        lo(c.key),
-        hi(c.key),
-        lo(c.gamma),
-        hi(c.gamma),
-        lo(c.stride),
-        hi(c.stride),
+        lo(d.seed),
+        hi(d.seed),
+        0,
+        0,
+        0,
+        0,
         nx,
         ny,
         2 * nx.div_ceil(64),
-        (c.step & 1) as u32,
+        0,
         c.restitution as u32,
         c.unit as u32,
         c.energy.0,

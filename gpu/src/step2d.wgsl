@@ -10,12 +10,12 @@
 //
 // 64-bit integers are vec2<u32> (low, high): WGSL has none.
 
-// params: 0-1 key, 2-3 gamma, 4-5 stride, 6 nx, 7 ny, 8 u32 words a row of
-// the occupancy, 9 offset, 10 restitution (Q16), 11 unit W, 12-13 the
-// clamp's energy factor (significand, exponent), 14 the faces (2 bits each:
-// x low, x high, y low, y high; 0 periodic, 1 wall, 2 open), 15 the walls'
-// restitution (Q16), 16-21 the uniform push G (x, y, z as 64-bit pairs),
-// 22 whether G is not 0.
+// params, the same every step: 0-1 the seed, 6 nx, 7 ny, 8 u32 words a row
+// of the occupancy, 10 restitution (Q16), 11 unit W, 12-13 the clamp's
+// energy factor (significand, exponent), 14 the faces (2 bits each: x low,
+// x high, y low, y high; 0 periodic, 1 wall, 2 open), 15 the walls'
+// restitution (Q16), 16-21 the uniform push G (x, y, z as 64-bit pairs), 22
+// whether G is not 0.
 @group(0) @binding(0) var<storage, read> params: array<u32>;
 // tables: 0..256 M5.3 move limits; 256..2304 the turns of M5.2 (cos, sin
 // as i32); 2304..3600 per 2D key its assignments (start | count << 16,
@@ -27,7 +27,8 @@
 @group(0) @binding(5) var<storage, read_write> vel_out: array<u32>;
 // counters: pairs (low, high) of collisions, clamps, clamp energy,
 // displaced, exited; 10 blocks processed in this step; 11 the clamp energy
-// saturated.
+// saturated; 12 blocks processed in the last step; 13-14 the number of the
+// step the world takes next, which `end_step` advances.
 @group(0) @binding(6) var<storage, read_write> counters: array<atomic<u32>>;
 
 const TURNS_AT: u32 = 256u;
@@ -113,6 +114,25 @@ fn mix64(z0: vec2<u32>) -> vec2<u32> {
     z = z ^ shr64(z, 27u);
     z = mul64(z, vec2<u32>(0x133111ebu, 0x94d049bbu));
     return z ^ shr64(z, 31u);
+}
+
+// M8: the step's key, increment and the stride between blocks' first
+// counters, from the seed and the step number.
+struct StepKey {
+    key: vec2<u32>,
+    gamma: vec2<u32>,
+    stride: vec2<u32>,
+}
+
+fn step_key(seed: vec2<u32>, step: vec2<u32>) -> StepKey {
+    let a = mix64(seed ^ vec2<u32>(0x626c6b00u, 0x6d706361u));
+    let key = mix64(a ^ mul64(step, vec2<u32>(0x7f4a7c15u, 0x9e3779b9u)));
+    var g = mix64(key ^ vec2<u32>(0x78bd642fu, 0xa0761d64u)) | vec2<u32>(1u, 0u);
+    let t = g ^ shr64(g, 1u);
+    if countOneBits(t.x) + countOneBits(t.y) < 24u {
+        g = g ^ vec2<u32>(0xaaaaaaaau, 0xaaaaaaaau);
+    }
+    return StepKey(key, g, shl64(g, 16u));
 }
 
 struct Stream {
@@ -530,7 +550,8 @@ fn step_2d(@builtin(global_invocation_id) id: vec3<u32>) {
     let nx = params[6];
     let ny = params[7];
     let row_u32 = params[8];
-    let o = params[9];
+    let step = vec2<u32>(atomicLoad(&counters[13]), atomicLoad(&counters[14]));
+    let o = step.x & 1u;
     // M3: per axis the first block's lowest cell and the block count.
     let periodic = vec2<bool>(face(0u, false) == 0u, face(1u, false) == 0u);
     var first = vec2<i32>(0, 0);
@@ -584,6 +605,7 @@ fn step_2d(@builtin(global_invocation_id) id: vec3<u32>) {
         out_vel[1][i] = 0u;
     }
     var counts = Counts(0u, 0u, vec2<u32>(0u, 0u), false, 0u, 0u, 0u);
+    let sk = step_key(vec2<u32>(params[0], params[1]), step);
     // The blocks with a cell in [lo, hi): x0 + 1 >= lo and x0 < hi.
     let bx_lo = (i32(lo) - first.x) >> 1u;
     let bx_hi = (i32(hi) - 1 - first.x) >> 1u;
@@ -634,8 +656,8 @@ fn step_2d(@builtin(global_invocation_id) id: vec3<u32>) {
         var block_counts = Counts(0u, 0u, vec2<u32>(0u, 0u), false, 0u, 1u, 0u);
         let index = u32(bx) + blocks.x * r;
         var s: Stream;
-        s.counter = add64(vec2<u32>(params[0], params[1]), mul64(vec2<u32>(params[4], params[5]), vec2<u32>(index, 0u)));
-        s.gamma = vec2<u32>(params[2], params[3]);
+        s.counter = add64(sk.key, mul64(sk.stride, vec2<u32>(index, 0u)));
+        s.gamma = sk.gamma;
         s.pool = vec2<u32>(0u, 0u);
         s.left = 0u;
         change(&b, &s, &block_counts);
@@ -693,6 +715,17 @@ fn step_2d(@builtin(global_invocation_id) id: vec3<u32>) {
     add_count(8u, counts.exited);
     if counts.processed != 0u {
         atomicAdd(&counters[10], counts.processed);
+    }
+}
+
+// After a step's sweep: its processed blocks become the last step's, and
+// the step number advances (M3's parity with it).
+@compute @workgroup_size(1)
+fn end_step() {
+    atomicStore(&counters[12], atomicExchange(&counters[10], 0u));
+    let low = atomicAdd(&counters[13], 1u);
+    if low == 0xffffffffu {
+        atomicAdd(&counters[14], 1u);
     }
 }
 

@@ -187,3 +187,23 @@ fn planes_that_are_not_a_world_are_refused_and_change_nothing() {
     };
     assert_eq!(aged.port_finish_steps(&o, &v, &one), Err(mpca::Error::NotEnabled));
 }
+
+#[test]
+fn steps_recorded_into_the_callers_encoder_step_as_on_the_cpu() {
+    // An engine's frame: its own encoder, two recordings in one
+    // submission; a sync before the submission says so, and one after it
+    // finds the CPU's world.
+    let gpu = gpu();
+    let mut w = gas(64, 32, 0.4, 9, |d| d.boundary[1] = [mpca::Boundary::Wall; 2]);
+    let mut g = GpuWorld::new(&gpu, &w).unwrap();
+    for frame in 0..3 {
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        g.record(&mut encoder, 2);
+        g.record(&mut encoder, 3);
+        assert!(matches!(g.sync(), Err(mpca_gpu::Error::Unsubmitted)), "frame {frame}");
+        gpu.queue.submit([encoder.finish()]);
+        w.step(5);
+        let on_gpu = g.sync().unwrap();
+        assert_eq!((on_gpu.stats(), on_gpu.state_hash()), (w.stats(), w.state_hash()), "frame {frame}");
+    }
+}

@@ -82,12 +82,9 @@ pub struct PortPlanes<'a> {
 }
 
 impl World {
-    /// The integers of the step `ahead` steps after the one this world
-    /// takes next (M1c, M8): a backend that runs several steps before it
-    /// counts them into this world ([`World::port_finish_steps`]) asks
-    /// with the steps it has run.
-    pub fn port_constants_ahead(&self, ahead: u64) -> StepConstants {
-        let step = self.head.step.wrapping_add(ahead);
+    /// The integers of the step this world takes next (M1c, M8).
+    pub fn port_constants(&self) -> StepConstants {
+        let step = self.head.step;
         let desc = &self.head.desc;
         let unit = crate::rules::quant::with_quant!(desc.quantization, Q => Q::UNIT);
         let (s, fine) = (unit >> unit.trailing_zeros(), unit.trailing_zeros());
