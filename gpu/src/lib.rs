@@ -39,6 +39,9 @@
 //! # }
 //! ```
 
+mod export;
+
+pub use export::Exports;
 use mpca::port::{StepCounts, StepConstants};
 use mpca::{Boundary, Collisions, Description, Identity, Method, Quantization, World, WorldBox};
 use wgpu::util::DeviceExt;
@@ -105,6 +108,22 @@ impl Gpu {
     /// The caller's device and queue.
     pub fn from_device(device: wgpu::Device, queue: wgpu::Queue) -> Gpu {
         Gpu { device, queue, adapter: String::from("the caller's device") }
+    }
+
+    /// The contents of `buffer` (which needs `COPY_SRC`), read back after
+    /// everything submitted before: a copy into a buffer the CPU maps.
+    /// Waits for the GPU.
+    pub fn read(&self, buffer: &wgpu::Buffer) -> Vec<u8> {
+        let size = buffer.size();
+        let staging = self.device.create_buffer(&wgpu::BufferDescriptor { label: Some("read back"), size, usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST, mapped_at_creation: false });
+        let mut encoder = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("read back") });
+        encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, size);
+        self.queue.submit([encoder.finish()]);
+        staging.slice(..).map_async(wgpu::MapMode::Read, |r| r.expect("mapping a read-back buffer"));
+        self.device.poll(wgpu::PollType::Wait { submission_index: None, timeout: None }).expect("waiting for the GPU");
+        let bytes = staging.slice(..).get_mapped_range().expect("a mapped read-back buffer").to_vec();
+        staging.unmap();
+        bytes
     }
 }
 
@@ -300,9 +319,9 @@ impl GpuWorld {
     /// was at the last sync.
     pub fn sync(&mut self) -> Result<&World, Error> {
         if self.pending > 0 {
-            let occupancy: Vec<u64> = self.read(&self.occupancy[self.current]).chunks_exact(8).map(|b| u64::from_le_bytes(b.try_into().expect("8 bytes"))).collect();
-            let mut velocity = self.read(&self.velocity[self.current]);
-            let counters: Vec<u32> = bytemuck::cast_slice(&self.read(&self.counters)).to_vec();
+            let occupancy: Vec<u64> = self.gpu.read(&self.occupancy[self.current]).chunks_exact(8).map(|b| u64::from_le_bytes(b.try_into().expect("8 bytes"))).collect();
+            let mut velocity = self.gpu.read(&self.velocity[self.current]);
+            let counters: Vec<u32> = bytemuck::cast_slice(&self.gpu.read(&self.counters)).to_vec();
             // The buffer is padded to whole words.
             velocity.truncate(self.host.port_planes().velocity.len());
             let wide = |i: usize| u64::from(counters[i]) | u64::from(counters[i + 1]) << 32;
@@ -326,20 +345,6 @@ impl GpuWorld {
         Ok(&self.host)
     }
 
-    /// The contents of `buffer`, read back (waits for the GPU).
-    fn read(&self, buffer: &wgpu::Buffer) -> Vec<u8> {
-        let device = &self.gpu.device;
-        let size = buffer.size();
-        let staging = device.create_buffer(&wgpu::BufferDescriptor { label: Some("read back"), size, usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST, mapped_at_creation: false });
-        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("read back") });
-        encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, size);
-        self.gpu.queue.submit([encoder.finish()]);
-        staging.slice(..).map_async(wgpu::MapMode::Read, |r| r.expect("mapping a read-back buffer"));
-        device.poll(wgpu::PollType::Wait { submission_index: None, timeout: None }).expect("waiting for the GPU");
-        let bytes = staging.slice(..).get_mapped_range().expect("a mapped read-back buffer").to_vec();
-        staging.unmap();
-        bytes
-    }
 }
 
 /// The shader's parameters (`step2d.wgsl`).

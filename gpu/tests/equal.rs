@@ -207,3 +207,51 @@ fn steps_recorded_into_the_callers_encoder_step_as_on_the_cpu() {
         assert_eq!((on_gpu.stats(), on_gpu.state_hash()), (w.stats(), w.state_hash()), "frame {frame}");
     }
 }
+
+#[test]
+fn the_exports_hold_the_cpus_particles_in_its_order() {
+    // After steps recorded with the exports in the same encoder: every
+    // particle's cell and velocity in the CPU's order, the draw's count,
+    // and the density of each 4 x 4 tile (rows of the texture read through
+    // a buffer, padded to 256 bytes).
+    let gpu = gpu();
+    let mut w = gas(70, 36, 0.35, 21, |d| d.boundary[0] = [mpca::Boundary::Open; 2]);
+    let mut g = GpuWorld::new(&gpu, &w).unwrap();
+    let exports = mpca_gpu::Exports::new(&g, 4).unwrap();
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    g.record(&mut encoder, 9);
+    exports.record(&g, &mut encoder);
+    let (tw, th) = (70u32.div_ceil(4), 36u32.div_ceil(4));
+    let texels = gpu.device.create_buffer(&wgpu::BufferDescriptor { label: None, size: 256 * u64::from(th), usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC, mapped_at_creation: false });
+    encoder.copy_texture_to_buffer(
+        exports.density.as_image_copy(),
+        wgpu::TexelCopyBufferInfo { buffer: &texels, layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(256), rows_per_image: None } },
+        exports.density.size(),
+    );
+    gpu.queue.submit([encoder.finish()]);
+    w.step(9);
+    assert!(w.stats().exited > 0, "the test wants particles gone through the open faces");
+    let particles: Vec<[f32; 4]> = bytemuck::cast_slice::<u8, [f32; 4]>(&gpu.read(&exports.particles)).to_vec();
+    let draw: Vec<u32> = bytemuck::cast_slice(&gpu.read(&exports.draw)).to_vec();
+    let cpu: Vec<_> = w.particles().collect();
+    assert_eq!(draw, [6, cpu.len() as u32, 0, 0]);
+    for (i, p) in cpu.iter().enumerate() {
+        let q = particles[i];
+        assert_eq!([q[0], q[1]], [p.pos[0] as f32 + 0.5, p.pos[1] as f32 + 0.5], "particle {i}");
+        for k in 0..2 {
+            assert!((q[2 + k] - p.velocity[k]).abs() <= 1e-6, "particle {i}: {q:?} {p:?}");
+        }
+    }
+    let texels = gpu.read(&texels);
+    for ty in 0..th {
+        for tx in 0..tw {
+            let at = (256 * ty + 8 * tx) as usize;
+            let share = half::f16::from_le_bytes([texels[at], texels[at + 1]]).to_f32();
+            let n = cpu.iter().filter(|p| p.pos[0] / 4 == tx && p.pos[1] / 4 == ty).count();
+            assert_eq!(share, n as f32 / 16.0, "tile {tx} {ty}");
+        }
+    }
+    // The world itself is the CPU's.
+    assert_eq!(g.sync().unwrap().state_hash(), w.state_hash());
+}
+
