@@ -192,6 +192,10 @@ pub struct GpuWorld {
     /// Steps run on the GPU since the last sync.
     pending: u64,
     pipeline: wgpu::ComputePipeline,
+    /// The world's integers and the rule's tables (`step2d.wgsl`), written
+    /// again when an image brings another description.
+    params: wgpu::Buffer,
+    tables: wgpu::Buffer,
     /// `end_step`: the last step's processed blocks, the step number.
     end: wgpu::ComputePipeline,
     end_group: wgpu::BindGroup,
@@ -224,18 +228,10 @@ impl GpuWorld {
         let p = host.port_planes();
         let (occupancy, velocity) = (bytemuck::cast_slice::<u64, u8>(p.occupancy).to_vec(), p.velocity.to_vec());
         let storage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
-        let buffer = |label: &str, bytes: &[u8]| {
-            // A buffer's size is a multiple of 4 bytes, at least 4.
-            let mut contents = bytes.to_vec();
-            contents.resize(bytes.len().next_multiple_of(4).max(4), 0);
-            device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents: &contents, usage: storage })
-        };
+        let buffer = |label: &str, bytes: &[u8]| device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents: &padded(bytes), usage: storage });
         let occupancy = [buffer("occupancy 0", &occupancy), buffer("occupancy 1", &occupancy)];
         let velocity = [buffer("velocity 0", &velocity), buffer("velocity 1", &velocity)];
-        let mut start = [0u32; COUNTERS];
-        let step = host.stats().step;
-        (start[13], start[14]) = (step as u32, (step >> 32) as u32);
-        let counters = buffer("counters", bytemuck::cast_slice(&start));
+        let counters = buffer("counters", bytemuck::cast_slice(&counters_of(&host)));
         let params = buffer("params", bytemuck::cast_slice(&params(&host.port_constants(), &desc)));
         let tables = buffer("tables", bytemuck::cast_slice(&tables(mpca::port::move_table_8(desc.drift))));
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some("step2d.wgsl"), source: wgpu::ShaderSource::Wgsl(include_str!("step2d.wgsl").into()) });
@@ -269,6 +265,8 @@ impl GpuWorld {
             host,
             pending: 0,
             pipeline,
+            params,
+            tables,
             end,
             end_group,
             occupancy,
@@ -280,6 +278,36 @@ impl GpuWorld {
             // more (the shader skips the row where it has not).
             dispatch: [words.div_ceil(64), ny / 2 + 1],
         })
+    }
+
+    /// Replaces the world with the one `image` holds (a snapshot, M12),
+    /// mid-run: its state, counters, step number and settings. The image
+    /// must be of a world of this size that this backend runs; otherwise
+    /// it is refused (as [`mpca::World::load`] refuses it, `ImageMismatch`
+    /// for another size, `FeatureDisabled` for a part not run here) and
+    /// nothing changes. Steps run since the last sync are dropped with the
+    /// old world. The new world is written through the queue, after what
+    /// was submitted before.
+    pub fn load(&mut self, image: &[u8]) -> Result<(), Error> {
+        let desc = mpca::image_description(image)?;
+        if desc.size != self.host.description().size || desc.dim != self.host.description().dim {
+            return Err(Error::World(mpca::Error::ImageMismatch));
+        }
+        if unsupported(&desc).is_some() {
+            return Err(Error::World(mpca::Error::FeatureDisabled));
+        }
+        let mut host = WorldBox::new(&desc)?;
+        host.load(image)?;
+        let queue = &self.gpu.queue;
+        let p = host.port_planes();
+        queue.write_buffer(&self.occupancy[self.current], 0, bytemuck::cast_slice(p.occupancy));
+        queue.write_buffer(&self.velocity[self.current], 0, &padded(p.velocity));
+        queue.write_buffer(&self.counters, 0, bytemuck::cast_slice(&counters_of(&host)));
+        queue.write_buffer(&self.params, 0, bytemuck::cast_slice(&params(&host.port_constants(), &desc)));
+        queue.write_buffer(&self.tables, 0, bytemuck::cast_slice(&tables(mpca::port::move_table_8(desc.drift))));
+        self.host = host;
+        self.pending = 0;
+        Ok(())
     }
 
     /// Runs `n` steps on the GPU: [`GpuWorld::record`] into an encoder of
@@ -345,6 +373,22 @@ impl GpuWorld {
         Ok(&self.host)
     }
 
+}
+
+/// `bytes` padded to a buffer's size: a multiple of 4 bytes, at least 4.
+fn padded(bytes: &[u8]) -> Vec<u8> {
+    let mut contents = bytes.to_vec();
+    contents.resize(bytes.len().next_multiple_of(4).max(4), 0);
+    contents
+}
+
+/// The counters buffer of a world as `host` holds it: nothing counted yet
+/// on the GPU, and the number of the step it takes next.
+fn counters_of(host: &World) -> [u32; COUNTERS] {
+    let mut counters = [0u32; COUNTERS];
+    let step = host.stats().step;
+    (counters[13], counters[14]) = (step as u32, (step >> 32) as u32);
+    counters
 }
 
 /// The shader's parameters (`step2d.wgsl`).

@@ -255,3 +255,38 @@ fn the_exports_hold_the_cpus_particles_in_its_order() {
     assert_eq!(g.sync().unwrap().state_hash(), w.state_hash());
 }
 
+
+#[test]
+fn a_world_moves_between_the_cpu_and_the_gpu_through_its_image_mid_run() {
+    // A GPU world runs a world of its own, then takes the CPU's image at
+    // step 10 (another seed and restitution: its settings come with it),
+    // runs on, and its image comes back to a fresh CPU world that runs on:
+    // all equal to the CPU's own run. Images of another size, or of a part
+    // the backend does not run, are refused and change nothing.
+    let gpu = gpu();
+    let walls = |d: &mut Description| d.boundary[1] = [mpca::Boundary::Wall; 2];
+    let mut cpu = gas(48, 40, 0.4, 31, walls);
+    let mut g = GpuWorld::new(&gpu, &gas(48, 40, 0.2, 32, |d| {
+        walls(d);
+        d.restitution = 0.3;
+    }))
+    .unwrap();
+    g.step(7);
+    cpu.step(10);
+    g.load(&image(&cpu)).unwrap();
+    let before = g.sync().unwrap().state_hash();
+    assert_eq!(before, cpu.state_hash());
+    for (other, why) in [(gas(50, 40, 0.4, 31, walls), mpca::Error::ImageMismatch), (gas(48, 40, 0.4, 31, |d| d.contacts = true), mpca::Error::FeatureDisabled)] {
+        assert!(matches!(g.load(&image(&other)), Err(mpca_gpu::Error::World(e)) if e == why));
+        assert_eq!(g.sync().unwrap().state_hash(), before);
+    }
+    g.step(15);
+    cpu.step(15);
+    let back = image(g.sync().unwrap());
+    assert!(back == image(&cpu));
+    let mut again = WorldBox::new(&mpca::image_description(&back).unwrap()).unwrap();
+    again.load(&back).unwrap();
+    again.step(5);
+    cpu.step(5);
+    assert_eq!((again.stats(), again.state_hash()), (cpu.stats(), cpu.state_hash()));
+}
