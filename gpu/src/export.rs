@@ -62,8 +62,8 @@ impl Exports {
             usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC,
             view_formats: &[],
         });
-        let unit = if world.host.description().quantization == mpca::Quantization::Bits16 { 32767 } else { 127 };
-        let info = [nx, ny, 2 * nx.div_ceil(64), tile, capacity as u32, unit];
+        let wide = world.host.description().quantization == mpca::Quantization::Bits16;
+        let info = [nx, ny, 2 * nx.div_ceil(64), tile, capacity as u32, if wide { 32767 } else { 127 }, u32::from(wide)];
         let info = device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some("export info"), contents: bytemuck::cast_slice(&info), usage: wgpu::BufferUsages::STORAGE });
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some("export2d.wgsl"), source: wgpu::ShaderSource::Wgsl(include_str!("export2d.wgsl").into()) });
         let entries = ["count_rows", "scan_rows", "write_particles", "write_density"];

@@ -7,7 +7,8 @@
 // floats are fine here.
 
 // info: 0 nx, 1 ny, 2 u32 words a row of the occupancy, 3 the tile's side
-// in cells, 4 the particles' buffer's capacity, 5 quanta to a unit speed.
+// in cells, 4 the particles' buffer's capacity, 5 quanta to a unit speed,
+// 6 16-bit storage.
 @group(0) @binding(0) var<storage, read> info: array<u32>;
 @group(0) @binding(1) var<storage, read> occ: array<u32>;
 @group(0) @binding(2) var<storage, read> vel: array<u32>;
@@ -22,9 +23,16 @@
 @group(0) @binding(5) var<storage, read_write> draw: array<u32>;
 @group(0) @binding(6) var density: texture_storage_2d<rgba16float, write>;
 
+// Cell i's velocity in cells a step: two bytes a cell (8-bit), or a word
+// of two 16-bit halves.
 fn velocity(i: u32) -> vec2<f32> {
-    let half = vel[i >> 1u] >> (16u * (i & 1u));
-    let q = vec2<i32>(i32(half << 24u) >> 24u, i32(half << 16u) >> 24u);
+    var q: vec2<i32>;
+    if info[6] != 0u {
+        q = vec2<i32>(i32(vel[i] << 16u) >> 16u, i32(vel[i]) >> 16u);
+    } else {
+        let half = vel[i >> 1u] >> (16u * (i & 1u));
+        q = vec2<i32>(i32(half << 24u) >> 24u, i32(half << 16u) >> 24u);
+    }
     return vec2<f32>(q) / f32(info[5]);
 }
 

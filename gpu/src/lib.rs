@@ -11,8 +11,8 @@
 //! planes and the counters down into it, which checks them, and from there
 //! come the hash, the statistics and the snapshot image.
 //!
-//! This version runs the 2D rule with 8-bit velocities and one mass on any
-//! faces: the uniform force (M5.1), collisions (M5.2, any restitution),
+//! This version runs the 2D rule with 8-bit or 16-bit velocities and one
+//! mass on any faces: the uniform force (M5.1), collisions (M5.2, any restitution),
 //! both drift rules (M5.3), reflection off walls (M5.4), the exact-fast
 //! assignment (M5.6) and exits through open faces: the paper's aggregation
 //! and cluster scenes and the benchmark's gas. A description that needs any
@@ -43,7 +43,7 @@ mod export;
 
 pub use export::Exports;
 use mpca::port::{StepCounts, StepConstants};
-use mpca::{Boundary, Collisions, Description, Identity, Method, Quantization, World, WorldBox};
+use mpca::{Boundary, Collisions, Description, Drift, Identity, Method, Quantization, World, WorldBox};
 use wgpu::util::DeviceExt;
 
 /// Why a GPU world could not be made or stepped.
@@ -129,9 +129,8 @@ impl Gpu {
 
 /// Why this backend cannot run a description: `None` where it can.
 pub fn unsupported(d: &Description) -> Option<&'static str> {
-    let checks: [(bool, &'static str); 12] = [
+    let checks: [(bool, &'static str); 11] = [
         (d.dim == 2, "3D worlds"),
-        (d.quantization == Quantization::Bits8, "16-bit velocities"),
         (!d.per_particle_mass, "per-particle masses"),
         (!d.obstacles, "obstacles"),
         (!(d.forces.field || d.forces.potential || d.forces.vortex), "force fields, potentials and the vortex"),
@@ -421,7 +420,7 @@ fn params(c: &StepConstants, d: &Description) -> [u32; PARAMS] {
         nx,
         ny,
         2 * nx.div_ceil(64),
-        0,
+        u32::from(d.quantization == Quantization::Bits16),
         c.restitution as u32,
         c.unit as u32,
         c.energy.0,
@@ -435,6 +434,6 @@ fn params(c: &StepConstants, d: &Description) -> [u32; PARAMS] {
         lo(g[2]),
         hi(g[2]),
         u32::from(c.push != [0; 3]),
-        0,
+        u32::from(d.drift == Drift::Calibrated),
     ]
 }

@@ -1,5 +1,5 @@
-// The local map of M5 on the 2D blocks of one step, for 8-bit storage and
-// one mass, as docs/model.md states it (M1c, M3, M4, M5, M8). One invocation owns one
+// The local map of M5 on the 2D blocks of one step, for 8-bit and 16-bit
+// storage and one mass, as docs/model.md states it (M1c, M3, M4, M5, M8). One invocation owns one
 // 32-cell word of the occupancy in each of the two domain rows of a row of
 // blocks, and the velocities of those cells: it processes every block that
 // touches them (at offset 1 the two blocks that straddle its edges are also
@@ -11,11 +11,12 @@
 // 64-bit integers are vec2<u32> (low, high): WGSL has none.
 
 // params, the same every step: 0-1 the seed, 6 nx, 7 ny, 8 u32 words a row
-// of the occupancy, 10 restitution (Q16), 11 unit W, 12-13 the clamp's
+// of the occupancy, 9 the storage's width (0: 8 bits, 1: 16), 10
+// restitution (Q16), 11 unit W, 12-13 the clamp's
 // energy factor (significand, exponent), 14 the faces (2 bits each: x low,
 // x high, y low, y high; 0 periodic, 1 wall, 2 open), 15 the walls'
 // restitution (Q16), 16-21 the uniform push G (x, y, z as 64-bit pairs), 22
-// whether G is not 0.
+// whether G is not 0, 23 the calibrated drift rule.
 @group(0) @binding(0) var<storage, read> params: array<u32>;
 // tables: 0..256 M5.3 move limits; 256..2304 the turns of M5.2 (cos, sin
 // as i32); 2304..3600 per 2D key its assignments (start | count << 16,
@@ -282,11 +283,46 @@ fn clamp_speed(x: vec2<i32>, counts: ptr<function, Counts>) -> vec2<i32> {
     return out;
 }
 
-// M1: a working velocity (fine units of 2^-16 quanta) to stored quanta,
-// 16 random bits a component.
+// 16-bit storage (params[9]).
+fn wide() -> bool {
+    return params[9] != 0u;
+}
+
+// M1c's F: fine bits a quantum.
+fn fine() -> u32 {
+    return select(16u, 12u, wide());
+}
+
+// M1: a working velocity (fine units of 2^-F quanta) to stored quanta, the
+// low F of 16 random bits a component.
 fn round_velocity(x: vec2<i32>, s: ptr<function, Stream>) -> vec2<i32> {
     let r = bits(s, 32u);
-    return vec2<i32>((x.x + i32(r & 0xffffu)) >> 16u, (x.y + i32(r >> 16u)) >> 16u);
+    let mask = (1u << fine()) - 1u;
+    return vec2<i32>((x.x + i32(r & mask)) >> fine(), (x.y + i32((r >> 16u) & mask)) >> fine());
+}
+
+// M5.3 for 16-bit storage: one less than the threshold of |q| (M1c),
+// floor((num 2^17 + den) / (2 den)) with (num, den) = (a, S) under the
+// paper's rule and (2a, S + a) under the calibrated one (params[23]), by
+// long division: the numerator takes 34 bits.
+fn move_limit_16(q: i32) -> u32 {
+    let a = min(u32(abs(q)), 32767u);
+    let calibrated = params[23] != 0u;
+    let num = select(a, 2u * a, calibrated);
+    let den = select(32767u, 32767u + a, calibrated);
+    let n = add64(shl64(vec2<u32>(num, 0u), 17u), vec2<u32>(den, 0u));
+    let d = 2u * den;
+    var rest = 0u;
+    var quotient = 0u;
+    for (var i = 34; i >= 0; i--) {
+        rest = (rest << 1u) | (shr64(n, u32(i)).x & 1u);
+        quotient = quotient << 1u;
+        if rest >= d {
+            rest -= d;
+            quotient |= 1u;
+        }
+    }
+    return max(quotient, 1u) - 1u;
 }
 
 // ---- The block ----------------------------------------------------------
@@ -380,7 +416,7 @@ fn change(b: ptr<function, Block>, s: ptr<function, Stream>, counts: ptr<functio
     var x: array<vec2<i32>, 4>;
     var changed = 0u;
     for (var c = 0u; c < 4u; c++) {
-        x[c] = (*b).v[c] << vec2<u32>(16u);
+        x[c] = (*b).v[c] << vec2<u32>(fine());
         if params[22] != 0u && ((*b).occ >> c & 1u) != 0u {
             x[c] = clamp_speed(pushed(x[c]), counts);
             changed |= 1u << c;
@@ -409,7 +445,7 @@ fn change(b: ptr<function, Block>, s: ptr<function, Stream>, counts: ptr<functio
 // in fine units, then the clamp and M1. A particle asks for a wall cell
 // only moving into it (N.v < 0).
 fn reflect(q: vec2<i32>, n: vec2<i32>, s: ptr<function, Stream>, counts: ptr<function, Counts>) -> vec2<i32> {
-    let x = q << vec2<u32>(16u);
+    let x = q << vec2<u32>(fine());
     // The exact dot product, 64 bits.
     var dot = vec2<u32>(0u, 0u);
     for (var k = 0; k < 2; k++) {
@@ -460,7 +496,7 @@ fn desire(b: ptr<function, Block>, site: ptr<function, Site>, s: ptr<function, S
         let c = i / 2u;
         let q = (*b).v[c][i % 2u];
         let high = select(bytes.y, bytes.x, i < 4u) >> (8u * (i % 4u)) & 0xffu;
-        let limit = tables[u32(q) & 0xffu];
+        let limit = select(tables[u32(q) & 0xffu], move_limit_16(q), wide());
         let top = limit >> 8u;
         if high < top || (high == top && bits(s, 8u) <= (limit & 0xffu)) {
             want |= 1u << i;
@@ -518,8 +554,14 @@ fn occupied(x: u32, y: u32) -> u32 {
     return occ_in[y * params[8] + (x >> 5u)] >> (x & 31u) & 1u;
 }
 
+// The stored velocity of cell (x, y): two bytes a cell, two cells a word
+// (8-bit), or two 16-bit halves, a word a cell (16-bit).
 fn velocity(x: u32, y: u32) -> vec2<i32> {
     let i = y * params[6] + x;
+    if wide() {
+        let word = vel_in[i];
+        return vec2<i32>(i32(word << 16u) >> 16u, i32(word) >> 16u);
+    }
     let half = vel_in[i >> 1u] >> (16u * (i & 1u));
     return vec2<i32>(i32(half << 24u) >> 24u, i32(half << 16u) >> 24u);
 }
@@ -599,8 +641,9 @@ fn step_2d(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     var out_occ = array<u32, 2>(0u, 0u);
-    var out_vel: array<array<u32, 16>, 2>;
-    for (var i = 0u; i < 16u; i++) {
+    // The words of velocities it owns in each row: 16 (8-bit) or 32.
+    var out_vel: array<array<u32, 32>, 2>;
+    for (var i = 0u; i < 32u; i++) {
         out_vel[0][i] = 0u;
         out_vel[1][i] = 0u;
     }
@@ -678,9 +721,12 @@ fn step_2d(@builtin(global_invocation_id) id: vec3<u32>) {
             }
             let row = t >> 1u;
             out_occ[row] |= 1u << (x - lo);
-            let k = (x - lo) >> 1u;
-            let byte_pair = (u32(b.v[c].x) & 0xffu) | (u32(b.v[c].y) & 0xffu) << 8u;
-            out_vel[row][k] |= byte_pair << (16u * (x & 1u));
+            if wide() {
+                out_vel[row][x - lo] = (u32(b.v[c].x) & 0xffffu) | u32(b.v[c].y) << 16u;
+            } else {
+                let byte_pair = (u32(b.v[c].x) & 0xffu) | (u32(b.v[c].y) & 0xffu) << 8u;
+                out_vel[row][(x - lo) >> 1u] |= byte_pair << (16u * (x & 1u));
+            }
         }
         // Counted by the invocation that owns the block's first cell inside.
         let owner = u32(max(x0, 0));
@@ -700,8 +746,10 @@ fn step_2d(@builtin(global_invocation_id) id: vec3<u32>) {
             continue;
         }
         occ_out[rows[row].at * row_u32 + w] = out_occ[row];
-        let base = (rows[row].at * nx + lo) >> 1u;
-        for (var k = 0u; k < (hi - lo) / 2u; k++) {
+        let shift = select(1u, 0u, wide());
+        let base = (rows[row].at * nx + lo) >> shift;
+        let words = (hi - lo) >> shift;
+        for (var k = 0u; k < words; k++) {
             vel_out[base + k] = out_vel[row][k];
         }
     }

@@ -208,20 +208,20 @@ fn steps_recorded_into_the_callers_encoder_step_as_on_the_cpu() {
     }
 }
 
-#[test]
-fn the_exports_hold_the_cpus_particles_in_its_order() {
-    // After steps recorded with the exports in the same encoder: every
-    // particle's cell and velocity in the CPU's order, the draw's count,
-    // and the density of each 4 x 4 tile (rows of the texture read through
-    // a buffer, padded to 256 bytes).
+/// Steps `w` and a GPU copy of it 9 steps, with the exports recorded in
+/// the same encoder after the steps, and checks every particle's cell and
+/// velocity in the CPU's order, the draw's count, and the density of each
+/// 4 x 4 tile (the texture's rows read through a buffer, padded to 256
+/// bytes); and the world itself.
+fn exports_match(mut w: WorldBox) {
     let gpu = gpu();
-    let mut w = gas(70, 36, 0.35, 21, |d| d.boundary[0] = [mpca::Boundary::Open; 2]);
+    let [nx, ny, _] = w.description().size;
     let mut g = GpuWorld::new(&gpu, &w).unwrap();
     let exports = mpca_gpu::Exports::new(&g, 4).unwrap();
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
     g.record(&mut encoder, 9);
     exports.record(&g, &mut encoder);
-    let (tw, th) = (70u32.div_ceil(4), 36u32.div_ceil(4));
+    let (tw, th) = (nx.div_ceil(4), ny.div_ceil(4));
     let texels = gpu.device.create_buffer(&wgpu::BufferDescriptor { label: None, size: 256 * u64::from(th), usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC, mapped_at_creation: false });
     encoder.copy_texture_to_buffer(
         exports.density.as_image_copy(),
@@ -251,10 +251,18 @@ fn the_exports_hold_the_cpus_particles_in_its_order() {
             assert_eq!(share, n as f32 / 16.0, "tile {tx} {ty}");
         }
     }
-    // The world itself is the CPU's.
     assert_eq!(g.sync().unwrap().state_hash(), w.state_hash());
 }
 
+#[test]
+fn the_exports_hold_the_cpus_particles_in_its_order() {
+    for quantization in [mpca::Quantization::Bits8, mpca::Quantization::Bits16] {
+        exports_match(gas(70, 36, 0.35, 21, |d| {
+            d.boundary[0] = [mpca::Boundary::Open; 2];
+            d.quantization = quantization;
+        }));
+    }
+}
 
 #[test]
 fn a_world_moves_between_the_cpu_and_the_gpu_through_its_image_mid_run() {
@@ -289,4 +297,20 @@ fn a_world_moves_between_the_cpu_and_the_gpu_through_its_image_mid_run() {
     again.step(5);
     cpu.step(5);
     assert_eq!((again.stats(), again.state_hash()), (cpu.stats(), cpu.state_hash()));
+}
+
+#[test]
+fn sixteen_bit_velocities_step_as_on_the_cpu() {
+    // 16-bit storage (M1c: F = 12, the move limits computed, a word a
+    // cell) under both drift rules, with walls, an open face and gravity.
+    for drift in [Drift::Calibrated, Drift::Paper] {
+        let mut w = gas(66, 20, 0.5, 41, |d| {
+            d.quantization = mpca::Quantization::Bits16;
+            d.drift = drift;
+            d.boundary[0] = [mpca::Boundary::Wall, mpca::Boundary::Open];
+            d.forces.uniform = true;
+            d.gravity = [0.0, 0.01, 0.0];
+        });
+        same_worlds(&mut w, 24, 1);
+    }
 }
