@@ -12,8 +12,8 @@
 //! come the hash, the statistics and the snapshot image.
 //!
 //! This version runs the 2D rule with 8-bit or 16-bit velocities and one
-//! mass on any faces: the uniform force (M5.1), collisions (M5.2, any restitution),
-//! both drift rules (M5.3), reflection off walls (M5.4), the exact-fast
+//! mass on any faces: the uniform force (M5.1), collisions (M5.2 and
+//! M5.2b, any restitution), both drift rules (M5.3), reflection off walls (M5.4), the exact-fast
 //! assignment (M5.6) and exits through open faces: the paper's aggregation
 //! and cluster scenes and the benchmark's gas. A description that needs any
 //! other part is refused when the world is made, as a CPU build without
@@ -129,14 +129,13 @@ impl Gpu {
 
 /// Why this backend cannot run a description: `None` where it can.
 pub fn unsupported(d: &Description) -> Option<&'static str> {
-    let checks: [(bool, &'static str); 11] = [
+    let checks: [(bool, &'static str); 10] = [
         (d.dim == 2, "3D worlds"),
         (!d.per_particle_mass, "per-particle masses"),
         (!d.obstacles, "obstacles"),
         (!(d.forces.field || d.forces.potential || d.forces.vortex), "force fields, potentials and the vortex"),
         (d.drag.rate == 0.0, "flow drag"),
         (d.method == Method::ExactFast, "an assignment other than exact-fast"),
-        (d.collisions == Collisions::Paper, "speed-limited collisions"),
         (!d.contacts, "contacts"),
         (!d.energy_neutral, "energy-neutral rounding"),
         (d.emitter_capacity == 0 && !d.lifetimes, "emitters and lifetimes"),
@@ -391,7 +390,7 @@ fn counters_of(host: &World) -> [u32; COUNTERS] {
 }
 
 /// The shader's parameters (`step2d.wgsl`).
-const PARAMS: usize = 24;
+const PARAMS: usize = 26;
 
 /// A face as the shader reads it: 0 periodic, 1 wall, 2 open.
 fn face(b: Boundary) -> u32 {
@@ -435,5 +434,7 @@ fn params(c: &StepConstants, d: &Description) -> [u32; PARAMS] {
         hi(g[2]),
         u32::from(c.push != [0; 3]),
         u32::from(d.drift == Drift::Calibrated),
+        u32::from(d.collisions == Collisions::SpeedLimited),
+        c.speed_limit as u32,
     ]
 }

@@ -16,7 +16,8 @@
 // energy factor (significand, exponent), 14 the faces (2 bits each: x low,
 // x high, y low, y high; 0 periodic, 1 wall, 2 open), 15 the walls'
 // restitution (Q16), 16-21 the uniform push G (x, y, z as 64-bit pairs), 22
-// whether G is not 0, 23 the calibrated drift rule.
+// whether G is not 0, 23 the calibrated drift rule, 24 speed-limited
+// collisions (M5.2b), 25 their limit L (fine units).
 @group(0) @binding(0) var<storage, read> params: array<u32>;
 // tables: 0..256 M5.3 move limits; 256..2304 the turns of M5.2 (cos, sin
 // as i32); 2304..3600 per 2D key its assignments (start | count << 16,
@@ -382,9 +383,34 @@ fn pushed(x: vec2<i32>) -> vec2<i32> {
     return out;
 }
 
-// M5.2 on the pair (a, c) with working velocities xa, xc: eqs. 7-8 with R
-// a turn of 1,024 (one mass), both clamped. False where the pair has one
-// velocity within the speed limit (nothing drawn, nothing changed).
+// Eqs. 7-8 for the pair (a, c) with working velocities xa, xc and
+// |xa - xc| R = t, one mass: out[0] for a, out[1] for c, the pair's
+// momentum kept exactly.
+fn eqs_7_8(xa: vec2<i32>, xc: vec2<i32>, t: vec2<i32>) -> array<vec2<i32>, 2> {
+    let e = bitcast<i32>(params[10]);
+    var out: array<vec2<i32>, 2>;
+    for (var k = 0; k < 2; k++) {
+        let v0 = xc[k] + mulq(xa[k] - xc[k], 32768, 16u);
+        let u = mulq(t[k], e, 16u);
+        out[0][k] = v0 + mulq(u, 32768, 16u);
+        out[1][k] = xa[k] + xc[k] - out[0][k];
+    }
+    return out;
+}
+
+// d turned by one of 1,024 angles, uniformly (10 bits): |d| R for M5.2.
+fn turned(d: vec2<i32>, s: ptr<function, Stream>) -> vec2<i32> {
+    let j = bits(s, 10u);
+    let cs = bitcast<i32>(tables[TURNS_AT + 2u * j]);
+    let sn = bitcast<i32>(tables[TURNS_AT + 2u * j + 1u]);
+    return vec2<i32>(mulq(d.x, cs, 30u) - mulq(d.y, sn, 30u), mulq(d.x, sn, 30u) + mulq(d.y, cs, 30u));
+}
+
+// M5.2 on the pair (a, c) with working velocities xa, xc (R uniform; with
+// M5.2b, params[24], drawn again until both outgoing speeds are within the
+// limit L, params[25], at most 16 times, then along xa - xc), both clamped.
+// False where the pair has one velocity within the speed limit (nothing
+// drawn, nothing changed).
 fn collide(xa: vec2<i32>, xc: vec2<i32>, out: ptr<function, array<vec2<i32>, 2>>, s: ptr<function, Stream>, counts: ptr<function, Counts>) -> bool {
     (*counts).collisions += 1u;
     let unit = bitcast<i32>(params[11]);
@@ -392,21 +418,22 @@ fn collide(xa: vec2<i32>, xc: vec2<i32>, out: ptr<function, array<vec2<i32>, 2>>
         return false;
     }
     let d = xa - xc;
-    let j = bits(s, 10u);
-    let cs = bitcast<i32>(tables[TURNS_AT + 2u * j]);
-    let sn = bitcast<i32>(tables[TURNS_AT + 2u * j + 1u]);
-    let t = vec2<i32>(mulq(d.x, cs, 30u) - mulq(d.y, sn, 30u), mulq(d.x, sn, 30u) + mulq(d.y, cs, 30u));
-    let e = bitcast<i32>(params[10]);
-    var na: vec2<i32>;
-    var nc: vec2<i32>;
-    for (var k = 0; k < 2; k++) {
-        let v0 = xc[k] + mulq(xa[k] - xc[k], 32768, 16u);
-        let u = mulq(t[k], e, 16u);
-        na[k] = v0 + mulq(u, 32768, 16u);
-        nc[k] = xa[k] + xc[k] - na[k];
+    var pair: array<vec2<i32>, 2>;
+    if params[24] == 0u {
+        pair = eqs_7_8(xa, xc, turned(d, s));
+    } else {
+        let limit2 = mul32(params[25], params[25]);
+        var fits = false;
+        for (var i = 0; i < 16 && !fits; i++) {
+            pair = eqs_7_8(xa, xc, turned(d, s));
+            fits = !lt64(limit2, sq2(pair[0])) && !lt64(limit2, sq2(pair[1]));
+        }
+        if !fits {
+            pair = eqs_7_8(xa, xc, d);
+        }
     }
-    (*out)[0] = clamp_speed(na, counts);
-    (*out)[1] = clamp_speed(nc, counts);
+    (*out)[0] = clamp_speed(pair[0], counts);
+    (*out)[1] = clamp_speed(pair[1], counts);
     return true;
 }
 

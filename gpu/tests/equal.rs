@@ -314,3 +314,16 @@ fn sixteen_bit_velocities_step_as_on_the_cpu() {
         same_worlds(&mut w, 24, 1);
     }
 }
+
+#[test]
+fn speed_limited_collisions_step_as_on_the_cpu() {
+    // M5.2b: a dense elastic gas of particles up to nearly the unit
+    // speed, where tries are refused and drawn again, at both widths.
+    for quantization in [mpca::Quantization::Bits8, mpca::Quantization::Bits16] {
+        let mut w = gas(64, 32, 0.7, 51, |d| {
+            d.collisions = mpca::Collisions::SpeedLimited;
+            d.quantization = quantization;
+        });
+        same_worlds(&mut w, 20, 1);
+    }
+}

@@ -8,7 +8,7 @@
 //! world.
 
 use crate::api::desc::Drift;
-use crate::rules::fixed::{magnitude, parts, scaled, scaled_by};
+use crate::rules::fixed::{csqrt, magnitude, parts, scaled, scaled_by};
 use crate::rules::quant::Quant;
 use crate::rules::rng::StepKey;
 use crate::step::convert_class;
@@ -36,6 +36,9 @@ pub struct StepConstants {
     pub restitution: i32,
     /// M5.4's restitution of the walls in Q16.
     pub wall_restitution: i32,
+    /// M5.2b's limit on an outgoing speed in fine units: the unit speed
+    /// less `sqrt(D)` quanta, rounded up.
+    pub speed_limit: i32,
     /// The world's unit speed `W` in fine units (M1c).
     pub unit: i32,
     /// Fine bits per quantum, `F` (M1c).
@@ -99,6 +102,7 @@ impl World {
             push: if desc.forces.uniform { desc.gravity.map(|g| scaled_by(desc.dt, g, s as u32, fine as i32)) } else { [0; 3] },
             restitution: scaled(desc.restitution, 1.0, 16) as i32,
             wall_restitution: scaled(desc.wall_restitution, 1.0, 16) as i32,
+            speed_limit: unit - csqrt(u64::from(desc.dim) << (2 * fine), 1 << fine) as i32,
             unit,
             fine,
             energy: (m as u32, e),
