@@ -129,14 +129,13 @@ impl Gpu {
 
 /// Why this backend cannot run a description: `None` where it can.
 pub fn unsupported(d: &Description) -> Option<&'static str> {
-    let checks: [(bool, &'static str); 10] = [
+    let checks: [(bool, &'static str); 9] = [
         (d.dim == 2, "3D worlds"),
         (!d.per_particle_mass, "per-particle masses"),
         (!d.obstacles, "obstacles"),
         (!(d.forces.field || d.forces.potential || d.forces.vortex), "force fields, potentials and the vortex"),
         (d.drag.rate == 0.0, "flow drag"),
         (d.method == Method::ExactFast, "an assignment other than exact-fast"),
-        (!d.contacts, "contacts"),
         (!d.energy_neutral, "energy-neutral rounding"),
         (d.emitter_capacity == 0 && !d.lifetimes, "emitters and lifetimes"),
         (d.identity == Identity::NONE, "ids, ages and tags"),
@@ -390,7 +389,7 @@ fn counters_of(host: &World) -> [u32; COUNTERS] {
 }
 
 /// The shader's parameters (`step2d.wgsl`).
-const PARAMS: usize = 26;
+const PARAMS: usize = 27;
 
 /// A face as the shader reads it: 0 periodic, 1 wall, 2 open.
 fn face(b: Boundary) -> u32 {
@@ -436,5 +435,6 @@ fn params(c: &StepConstants, d: &Description) -> [u32; PARAMS] {
         u32::from(d.drift == Drift::Calibrated),
         u32::from(d.collisions == Collisions::SpeedLimited),
         c.speed_limit as u32,
+        u32::from(d.contacts),
     ]
 }

@@ -17,7 +17,7 @@
 // x high, y low, y high; 0 periodic, 1 wall, 2 open), 15 the walls'
 // restitution (Q16), 16-21 the uniform push G (x, y, z as 64-bit pairs), 22
 // whether G is not 0, 23 the calibrated drift rule, 24 speed-limited
-// collisions (M5.2b), 25 their limit L (fine units).
+// collisions (M5.2b), 25 their limit L (fine units), 26 contacts (M5.7).
 @group(0) @binding(0) var<storage, read> params: array<u32>;
 // tables: 0..256 M5.3 move limits; 256..2304 the turns of M5.2 (cos, sin
 // as i32); 2304..3600 per 2D key its assignments (start | count << 16,
@@ -473,15 +473,7 @@ fn change(b: ptr<function, Block>, s: ptr<function, Stream>, counts: ptr<functio
 // only moving into it (N.v < 0).
 fn reflect(q: vec2<i32>, n: vec2<i32>, s: ptr<function, Stream>, counts: ptr<function, Counts>) -> vec2<i32> {
     let x = q << vec2<u32>(fine());
-    // The exact dot product, 64 bits.
-    var dot = vec2<u32>(0u, 0u);
-    for (var k = 0; k < 2; k++) {
-        var p = mul32(u32(abs(x[k])), u32(abs(n[k])));
-        if (x[k] < 0) != (n[k] < 0) {
-            p = add64(~p, vec2<u32>(1u, 0u));
-        }
-        dot = add64(dot, p);
-    }
+    let dot = dot_q30(x, n);
     var y = x;
     if (dot.y >> 31u) != 0u {
         // dot >> 30 fits 32 bits: |x| < 2^28, |n| <= 2^30.
@@ -492,6 +484,76 @@ fn reflect(q: vec2<i32>, n: vec2<i32>, s: ptr<function, Stream>, counts: ptr<fun
         }
     }
     return round_velocity(clamp_speed(y, counts), s);
+}
+
+// The exact dot product of a working velocity and a Q30 vector, 64 bits
+// (two's complement).
+fn dot_q30(x: vec2<i32>, n: vec2<i32>) -> vec2<u32> {
+    var dot = vec2<u32>(0u, 0u);
+    for (var k = 0; k < 2; k++) {
+        var p = mul32(u32(abs(x[k])), u32(abs(n[k])));
+        if (x[k] < 0) != (n[k] < 0) {
+            p = add64(~p, vec2<u32>(1u, 0u));
+        }
+        dot = add64(dot, p);
+    }
+    return dot;
+}
+
+// The unit vector from cell `toward` of a block back to cell `back`, in
+// Q30: an axis or the diagonal.
+fn back_normal(back: u32, toward: u32) -> vec2<i32> {
+    let n = vec2<i32>(i32(back & 1u) - i32(toward & 1u), i32(back >> 1u & 1u) - i32(toward >> 1u & 1u));
+    return n * select(1 << 30u, DIAGONAL, n.x != 0 && n.y != 0);
+}
+
+// M5.7 (params[26]): every particle refused the cell it wanted meets the
+// particle placed there, in the order of the refused particles' cells:
+// eqs. 7-8 with R from the wanted cell back to its own, where it was
+// closing in; both clamped; then M1 for every velocity a contact changed,
+// in cell order.
+fn contacts(b: ptr<function, Block>, want: u32, targets: u32, s: ptr<function, Stream>, counts: ptr<function, Counts>) {
+    let occ = (*b).occ;
+    var x: array<vec2<i32>, 4>;
+    for (var c = 0u; c < 4u; c++) {
+        x[c] = (*b).v[c] << vec2<u32>(fine());
+    }
+    var changed = 0u;
+    for (var a = 0u; a < 4u; a++) {
+        let m = want >> (2u * a) & 3u;
+        let wanted = a ^ m;
+        if (occ >> a & 1u) == 0u || m == 0u || (targets >> (2u * a) & 3u) == wanted {
+            continue;
+        }
+        var h = 4u;
+        for (var c = 0u; c < 4u; c++) {
+            if h == 4u && (occ >> c & 1u) != 0u && (targets >> (2u * c) & 3u) == wanted {
+                h = c;
+            }
+        }
+        if h == 4u {
+            continue;
+        }
+        let r = back_normal(a, wanted);
+        let d = x[a] - x[h];
+        let dot = dot_q30(d, r);
+        if (dot.y >> 31u) == 0u {
+            continue; // not closing in: dot >= 0
+        }
+        // |d| rounded to nearest.
+        let n = sq2(d);
+        let root = isqrt64(n).x;
+        let length = i32(root + select(0u, 1u, lt64(vec2<u32>(root, 0u), sub64(n, mul32(root, root)))));
+        let pair = eqs_7_8(x[a], x[h], vec2<i32>(mulq(length, r.x, 30u), mulq(length, r.y, 30u)));
+        x[a] = clamp_speed(pair[0], counts);
+        x[h] = clamp_speed(pair[1], counts);
+        changed |= (1u << a) | (1u << h);
+    }
+    for (var c = 0u; c < 4u; c++) {
+        if (changed >> c & 1u) != 0u {
+            (*b).v[c] = round_velocity(x[c], s);
+        }
+    }
 }
 
 // M5.3 with M5.4: the axes each particle wants to cross, two bits a cell.
@@ -733,6 +795,9 @@ fn step_2d(@builtin(global_invocation_id) id: vec3<u32>) {
         change(&b, &s, &block_counts);
         let want = desire(&b, &site, &s, &block_counts);
         let targets = assign(&b, site.wall, want, &s, &block_counts);
+        if params[26] != 0u && want != 0u {
+            contacts(&b, want, targets, &s, &block_counts);
+        }
         for (var c = 0u; c < 4u; c++) {
             if (b.occ >> c & 1u) == 0u {
                 continue;
