@@ -12,12 +12,13 @@
 //! come the hash, the statistics and the snapshot image.
 //!
 //! This version runs the 2D rule with 8-bit or 16-bit velocities and one
-//! mass on any faces: the uniform force (M5.1), collisions (M5.2 and
-//! M5.2b, any restitution), both drift rules (M5.3), reflection off walls (M5.4), the exact-fast
-//! assignment (M5.6) and exits through open faces: the paper's aggregation
-//! and cluster scenes and the benchmark's gas. A description that needs any
-//! other part is refused when the world is made, as a CPU build without
-//! that part refuses it ([`mpca::Error::FeatureDisabled`]).
+//! mass on any faces: the uniform force and the vortex (M5.1), collisions
+//! (M5.2 and M5.2b, any restitution), both drift rules (M5.3), reflection
+//! off walls (M5.4), the exact-fast assignment (M5.6), contacts (M5.7),
+//! exits through open faces and emitters (M6): the paper's aggregation,
+//! cluster and smoke scenes and the benchmark's gas. A description that
+//! needs any other part is refused when the world is made, as a CPU build
+//! without that part refuses it ([`mpca::Error::FeatureDisabled`]).
 //!
 //! ```
 //! use mpca::{Description, WorldBox};
@@ -42,7 +43,7 @@
 mod export;
 
 pub use export::Exports;
-use mpca::port::{StepCounts, StepConstants};
+use mpca::port::{StepConstants, StepCounts, VortexConstants};
 use mpca::{Boundary, Collisions, Description, Drift, Identity, Method, Quantization, World, WorldBox};
 use wgpu::util::DeviceExt;
 
@@ -133,11 +134,11 @@ pub fn unsupported(d: &Description) -> Option<&'static str> {
         (d.dim == 2, "3D worlds"),
         (!d.per_particle_mass, "per-particle masses"),
         (!d.obstacles, "obstacles"),
-        (!(d.forces.field || d.forces.potential || d.forces.vortex), "force fields, potentials and the vortex"),
+        (!(d.forces.field || d.forces.potential), "force fields and potentials"),
         (d.drag.rate == 0.0, "flow drag"),
         (d.method == Method::ExactFast, "an assignment other than exact-fast"),
         (!d.energy_neutral, "energy-neutral rounding"),
-        (d.emitter_capacity == 0 && !d.lifetimes, "emitters and lifetimes"),
+        (!d.lifetimes, "lifetimes"),
         (d.identity == Identity::NONE, "ids, ages and tags"),
     ];
     checks.iter().find(|(ok, _)| !ok).map(|(_, what)| *what)
@@ -174,11 +175,16 @@ fn tables(moves: &[u16; 256]) -> Vec<u32> {
 /// The counters buffer: pairs (low, high) of collisions, clamps, clamp
 /// energy, displaced, exited; the blocks processed in the step; a flag for
 /// a saturated clamp energy; the blocks processed in the last step; the
-/// number of the step the world takes next (low, high).
-const COUNTERS: usize = 15;
+/// number of the step the world takes next (low, high); pairs of the
+/// particles emitted and the emitters' shortfall.
+const COUNTERS: usize = 19;
+/// Words an emitter takes in the shader's emitter table.
+const EMITTER: usize = 16;
 /// The counters a sync takes into the CPU copy and clears: all but the
 /// step number.
 const COUNTED: usize = 13;
+/// Where the emitted particles and the shortfall lie in the counters.
+const EMITTED: usize = 15;
 
 /// A world stepped on the GPU, equal to the CPU's bit for bit.
 pub struct GpuWorld {
@@ -193,6 +199,11 @@ pub struct GpuWorld {
     /// again when an image brings another description.
     params: wgpu::Buffer,
     tables: wgpu::Buffer,
+    /// `emit` (M6) with its bindings, where the world has emitters: per
+    /// member of the pairs, the one it writes (the next step's input).
+    emit: Option<(wgpu::ComputePipeline, [wgpu::BindGroup; 2])>,
+    emitters: wgpu::Buffer,
+    emitter_stats: wgpu::Buffer,
     /// `end_step`: the last step's processed blocks, the step number.
     end: wgpu::ComputePipeline,
     end_group: wgpu::BindGroup,
@@ -229,7 +240,7 @@ impl GpuWorld {
         let occupancy = [buffer("occupancy 0", &occupancy), buffer("occupancy 1", &occupancy)];
         let velocity = [buffer("velocity 0", &velocity), buffer("velocity 1", &velocity)];
         let counters = buffer("counters", bytemuck::cast_slice(&counters_of(&host)));
-        let params = buffer("params", bytemuck::cast_slice(&params(&host.port_constants(), &desc)));
+        let params = buffer("params", bytemuck::cast_slice(&params(&host.port_constants(), &desc, emitter_count(&host) as u32)));
         let tables = buffer("tables", bytemuck::cast_slice(&tables(mpca::port::move_table_8(desc.drift))));
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some("step2d.wgsl"), source: wgpu::ShaderSource::Wgsl(include_str!("step2d.wgsl").into()) });
         let pipeline_of = |entry: &str| {
@@ -243,6 +254,21 @@ impl GpuWorld {
             })
         };
         let (pipeline, end) = (pipeline_of("step_2d"), pipeline_of("end_step"));
+        // Room for every emitter the world can hold: an image may bring
+        // another count.
+        let capacity = desc.emitter_capacity as usize;
+        let emitters = buffer("emitters", bytemuck::cast_slice(&emitter_table(&host, capacity)));
+        let emitter_stats = buffer("emitter stats", &vec![0u8; 16 * capacity]);
+        let emit = (capacity > 0).then(|| {
+            let pipeline = pipeline_of("emit");
+            let layout = pipeline.get_bind_group_layout(0);
+            let group = |member: usize| {
+                let entries = [(0, &params), (6, &counters), (7, &occupancy[member]), (8, &velocity[member]), (9, &emitters), (10, &emitter_stats)];
+                let entries: Vec<wgpu::BindGroupEntry<'_>> = entries.iter().map(|&(binding, b)| wgpu::BindGroupEntry { binding, resource: b.as_entire_binding() }).collect();
+                device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("emit"), layout: &layout, entries: &entries })
+            };
+            (pipeline, [group(0), group(1)])
+        });
         let end_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("end of step"),
             layout: &end.get_bind_group_layout(0),
@@ -264,6 +290,9 @@ impl GpuWorld {
             pipeline,
             params,
             tables,
+            emit,
+            emitters,
+            emitter_stats,
             end,
             end_group,
             occupancy,
@@ -300,8 +329,11 @@ impl GpuWorld {
         queue.write_buffer(&self.occupancy[self.current], 0, bytemuck::cast_slice(p.occupancy));
         queue.write_buffer(&self.velocity[self.current], 0, &padded(p.velocity));
         queue.write_buffer(&self.counters, 0, bytemuck::cast_slice(&counters_of(&host)));
-        queue.write_buffer(&self.params, 0, bytemuck::cast_slice(&params(&host.port_constants(), &desc)));
+        queue.write_buffer(&self.params, 0, bytemuck::cast_slice(&params(&host.port_constants(), &desc, emitter_count(&host) as u32)));
         queue.write_buffer(&self.tables, 0, bytemuck::cast_slice(&tables(mpca::port::move_table_8(desc.drift))));
+        let capacity = self.emitter_stats.size() as usize / 16;
+        queue.write_buffer(&self.emitters, 0, &padded(bytemuck::cast_slice(&emitter_table(&host, capacity))));
+        queue.write_buffer(&self.emitter_stats, 0, &vec![0u8; 16 * capacity]);
         self.host = host;
         self.pending = 0;
         Ok(())
@@ -326,6 +358,11 @@ impl GpuWorld {
     pub fn record(&mut self, encoder: &mut wgpu::CommandEncoder, n: u64) {
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("mpca steps"), timestamp_writes: None });
         for _ in 0..n {
+            if let Some((emit, groups)) = &self.emit {
+                pass.set_pipeline(emit);
+                pass.set_bind_group(0, &groups[self.current], &[]);
+                pass.dispatch_workgroups(1, 1, 1);
+            }
             pass.set_pipeline(&self.pipeline);
             pass.set_bind_group(0, &self.groups[self.current], &[]);
             pass.dispatch_workgroups(self.dispatch[0], self.dispatch[1], 1);
@@ -347,6 +384,9 @@ impl GpuWorld {
             let occupancy: Vec<u64> = self.gpu.read(&self.occupancy[self.current]).chunks_exact(8).map(|b| u64::from_le_bytes(b.try_into().expect("8 bytes"))).collect();
             let mut velocity = self.gpu.read(&self.velocity[self.current]);
             let counters: Vec<u32> = bytemuck::cast_slice(&self.gpu.read(&self.counters)).to_vec();
+            let stats: Vec<u64> = bytemuck::cast_slice::<u8, u32>(&self.gpu.read(&self.emitter_stats)).chunks_exact(2).map(|w| u64::from(w[0]) | u64::from(w[1]) << 32).collect();
+            let emitters = emitter_count(&self.host);
+            let emitted: Vec<mpca::EmitterStats> = (0..emitters).map(|i| mpca::EmitterStats { requested: stats[2 * i], delivered: stats[2 * i + 1] }).collect();
             // The buffer is padded to whole words.
             velocity.truncate(self.host.port_planes().velocity.len());
             let wide = |i: usize| u64::from(counters[i]) | u64::from(counters[i + 1]) << 32;
@@ -361,10 +401,14 @@ impl GpuWorld {
                 displaced: wide(6),
                 exited: wide(8),
                 blocks_processed: u64::from(counters[12]),
+                emitted: wide(EMITTED),
+                shortfall: wide(EMITTED + 2),
             };
-            self.host.port_finish_steps(&occupancy, &velocity, &counts)?;
+            self.host.port_finish_steps(&occupancy, &velocity, &counts, &emitted)?;
             // Counted into the CPU copy: the GPU's start again from zero.
             self.gpu.queue.write_buffer(&self.counters, 0, &[0u8; 4 * COUNTED]);
+            self.gpu.queue.write_buffer(&self.counters, 4 * EMITTED as u64, &[0u8; 16]);
+            self.gpu.queue.write_buffer(&self.emitter_stats, 0, &vec![0u8; self.emitter_stats.size() as usize]);
             self.pending = 0;
         }
         Ok(&self.host)
@@ -379,6 +423,22 @@ fn padded(bytes: &[u8]) -> Vec<u8> {
     contents
 }
 
+/// The emitters `host` has.
+fn emitter_count(host: &World) -> usize {
+    (0..).take_while(|&i| host.port_emitter(i).is_some()).count()
+}
+
+/// The shader's emitter table (`step2d.wgsl`, M6) for `capacity`
+/// emitters, those of `host` first.
+fn emitter_table(host: &World, capacity: usize) -> Vec<u32> {
+    let mut table = vec![0u32; EMITTER * capacity];
+    for (i, entry) in table.chunks_exact_mut(EMITTER).enumerate() {
+        let Some(e) = host.port_emitter(i) else { break };
+        entry[..10].copy_from_slice(&[e.min[0], e.min[1], e.max[0], e.max[1], e.whole as u32, (e.whole >> 32) as u32, e.threshold, e.velocity[0] as u32, e.velocity[1] as u32, e.radius as u32]);
+    }
+    table
+}
+
 /// The counters buffer of a world as `host` holds it: nothing counted yet
 /// on the GPU, and the number of the step it takes next.
 fn counters_of(host: &World) -> [u32; COUNTERS] {
@@ -389,7 +449,7 @@ fn counters_of(host: &World) -> [u32; COUNTERS] {
 }
 
 /// The shader's parameters (`step2d.wgsl`).
-const PARAMS: usize = 27;
+const PARAMS: usize = 36;
 
 /// A face as the shader reads it: 0 periodic, 1 wall, 2 open.
 fn face(b: Boundary) -> u32 {
@@ -402,12 +462,13 @@ fn face(b: Boundary) -> u32 {
 
 /// The shader's parameters, the same every step (`step2d.wgsl`), from
 /// the constants of any step `c`.
-fn params(c: &StepConstants, d: &Description) -> [u32; PARAMS] {
+fn params(c: &StepConstants, d: &Description, d_emitters: u32) -> [u32; PARAMS] {
     let lo = |x: u64| x as u32;
     let hi = |x: u64| (x >> 32) as u32;
     let (nx, ny) = (d.size[0], d.size[1]);
     let faces = face(d.boundary[0][0]) | face(d.boundary[0][1]) << 2 | face(d.boundary[1][0]) << 4 | face(d.boundary[1][1]) << 6;
     let g = c.push.map(|g| g as u64);
+    let v = c.vortex.unwrap_or(VortexConstants { centre: [0; 2], core: 0, g: 0, e: 0 });
     [
         lo(d.seed),
         hi(d.seed),
@@ -431,10 +492,19 @@ fn params(c: &StepConstants, d: &Description) -> [u32; PARAMS] {
         hi(g[1]),
         lo(g[2]),
         hi(g[2]),
-        u32::from(c.push != [0; 3]),
+        u32::from(c.push != [0; 3] || c.vortex.is_some()),
         u32::from(d.drift == Drift::Calibrated),
         u32::from(d.collisions == Collisions::SpeedLimited),
         c.speed_limit as u32,
         u32::from(d.contacts),
+        u32::from(c.vortex.is_some()),
+        lo(v.centre[0] as u64),
+        hi(v.centre[0] as u64),
+        lo(v.centre[1] as u64),
+        hi(v.centre[1] as u64),
+        v.core,
+        v.g as u32,
+        v.e as u32,
+        d_emitters,
     ]
 }

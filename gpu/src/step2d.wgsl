@@ -16,8 +16,11 @@
 // energy factor (significand, exponent), 14 the faces (2 bits each: x low,
 // x high, y low, y high; 0 periodic, 1 wall, 2 open), 15 the walls'
 // restitution (Q16), 16-21 the uniform push G (x, y, z as 64-bit pairs), 22
-// whether G is not 0, 23 the calibrated drift rule, 24 speed-limited
-// collisions (M5.2b), 25 their limit L (fine units), 26 contacts (M5.7).
+// whether a force is on (G not 0, or the vortex), 23 the calibrated drift rule, 24 speed-limited
+// collisions (M5.2b), 25 their limit L (fine units), 26 contacts (M5.7),
+// 27 the vortex force (M5.1), 28-31 its centre (x, y as 64-bit pairs,
+// 2^-8 cells), 32 its core (2^-8 cells), 33-34 its strength top(Γ') (g,
+// e), 35 the emitters.
 @group(0) @binding(0) var<storage, read> params: array<u32>;
 // tables: 0..256 M5.3 move limits; 256..2304 the turns of M5.2 (cos, sin
 // as i32); 2304..3600 per 2D key its assignments (start | count << 16,
@@ -30,8 +33,18 @@
 // counters: pairs (low, high) of collisions, clamps, clamp energy,
 // displaced, exited; 10 blocks processed in this step; 11 the clamp energy
 // saturated; 12 blocks processed in the last step; 13-14 the number of the
-// step the world takes next, which `end_step` advances.
+// step the world takes next, which `end_step` advances; pairs of the
+// particles emitted (15) and the emitters' shortfall (17).
 @group(0) @binding(6) var<storage, read_write> counters: array<atomic<u32>>;
+// The emitters' pass (`emit`) writes the planes the step then reads.
+@group(0) @binding(7) var<storage, read_write> occ_emit: array<u32>;
+@group(0) @binding(8) var<storage, read_write> vel_emit: array<u32>;
+// Per emitter (M6), 16 words: min x, min y, max x, max y, the rate's whole
+// part (64 bits), its 24-bit threshold, velocity x, y and spread (fine
+// units).
+@group(0) @binding(9) var<storage, read> emitters: array<u32>;
+// Per emitter, 4 words: requested, delivered (64-bit pairs).
+@group(0) @binding(10) var<storage, read_write> emitter_stats: array<u32>;
 
 const TURNS_AT: u32 = 256u;
 const KEYS_AT: u32 = 2304u;
@@ -160,9 +173,19 @@ fn bits(s: ptr<function, Stream>, n: u32) -> u32 {
     return r;
 }
 
-// A uniform number below n (at most 2^16): 16 bits a try, Lemire's
-// multiply and reject.
+// A uniform number below n: Lemire's multiply and reject, 16 bits a try
+// (32 where n > 2^16).
 fn below(s: ptr<function, Stream>, n: u32) -> u32 {
+    if n > 65536u {
+        var m = mul32(bits(s, 32u), n);
+        if m.x < n {
+            let threshold = (0u - n) % n;
+            while m.x < threshold {
+                m = mul32(bits(s, 32u), n);
+            }
+        }
+        return m.y;
+    }
     var m = bits(s, 16u) * n;
     if (m & 0xffffu) < n {
         let threshold = (65536u - n) % n;
@@ -272,10 +295,16 @@ fn clamp_speed(x: vec2<i32>, counts: ptr<function, Counts>) -> vec2<i32> {
         (*counts).saturated = true;
     }
     (*counts).energy = total;
-    // ceil(sqrt(s2)), then floor(2^32 W / L): never longer than W.
+    return shorten(x, s2);
+}
+
+// x, of squared length s2 above W^2, scaled back to W (M5.5): ceil(sqrt(s2)),
+// then floor(2^32 W / L), so never longer than W.
+fn shorten(x: vec2<i32>, s2: vec2<u32>) -> vec2<i32> {
+    let unit = params[11];
     let r = isqrt64(s2);
     let length = r.x + select(0u, 1u, lt64(mul32(r.x, r.x), s2));
-    let factor = long_division(u32(unit) << 1u, length, 32u);
+    let factor = long_division(unit << 1u, length, 32u);
     var out = x;
     for (var k = 0; k < 2; k++) {
         let scaled = i32(mul32(u32(abs(x[k])), factor).y);
@@ -353,23 +382,85 @@ fn face(k: u32, high: bool) -> u32 {
     return params[14] >> (4u * k + select(0u, 2u, high)) & 3u;
 }
 
-// A working velocity and the push G added, brought below 2^30 with its
-// direction kept (M1c's fit): G's z counts in the shift, as on the CPU.
-fn pushed(x: vec2<i32>) -> vec2<i32> {
+fn neg64(a: vec2<u32>) -> vec2<u32> {
+    return add64(~a, vec2<u32>(1u, 0u));
+}
+
+fn is_negative64(a: vec2<u32>) -> bool {
+    return (a.y >> 31u) != 0u;
+}
+
+// A 64-bit value clamped to [-bound, bound] (bound < 2^31).
+fn clamp64(a: vec2<u32>, bound: i32) -> i32 {
+    if is_negative64(a) {
+        let fits = a.y == 0xffffffffu && (a.x >> 31u) != 0u;
+        return select(-bound, max(bitcast<i32>(a.x), -bound), fits);
+    }
+    let fits = a.y == 0u && (a.x >> 31u) == 0u;
+    return select(bound, min(bitcast<i32>(a.x), bound), fits);
+}
+
+// M5.1's Rankine vortex at cell (x, y) as a push (M1c): the 16-bit
+// strength (params[33], exponent params[34]) over max(|d|^2, R'^2), with
+// the offsets and the core (params[28..33]) cut to 15 bits, one 32-bit
+// division, the last shift saturated at 2^59. Two 64-bit components.
+fn swirl(x: u32, y: u32) -> array<vec2<u32>, 2> {
+    let reach = 1 << 28u;
+    let at = array<u32, 2>(x, y);
+    var d: array<i32, 2>;
+    for (var k = 0u; k < 2u; k++) {
+        let cell = vec2<u32>((at[k] << 8u) + 128u, at[k] >> 24u);
+        d[k] = clamp64(sub64(cell, vec2<u32>(params[28u + 2u * k], params[29u + 2u * k])), reach);
+    }
+    var zero: array<vec2<u32>, 2>;
+    let g = bitcast<i32>(params[33]);
+    let core = params[32];
+    var ax = u32(abs(d[0]));
+    var ay = u32(abs(d[1]));
+    let big = max(max(ax, ay), core);
+    if big == 0u || g == 0 {
+        return zero;
+    }
+    let cut = max(32u - countLeadingZeros(big), 15u) - 15u;
+    ax = ax >> cut;
+    ay = ay >> cut;
+    let c = core >> cut;
+    let n = max(ax * ax + ay * ay, c * c);
+    let b = 32u - countLeadingZeros(n);
+    let top = select(n << (16u - b), n >> (b - 16u), b > 16u);
+    let f = (u32(abs(g)) << 15u) / top;
+    let e = bitcast<i32>(params[34]) - i32(cut) - i32(b) + 1;
+    var out: array<vec2<u32>, 2>;
+    let parts = array<u32, 2>(ay, ax);
+    let negative = array<bool, 2>(d[1] > 0, d[0] < 0);
+    for (var k = 0u; k < 2u; k++) {
+        let y = f * parts[k];
+        var m: vec2<u32>;
+        if e < 0 {
+            m = vec2<u32>(select(0u, y >> u32(-e), -e < 32), 0u);
+        } else if lt64(shr64(vec2<u32>(0u, 1u << 27u), u32(e)), vec2<u32>(y, 0u)) {
+            m = vec2<u32>(0u, 1u << 27u); // 2^59
+        } else {
+            m = shl64(vec2<u32>(y, 0u), u32(e));
+        }
+        out[k] = select(m, neg64(m), negative[k] != (g < 0));
+    }
+    return out;
+}
+
+// A working velocity with the push dv (three 64-bit components) added,
+// brought below 2^30 with its direction kept (M1c's fit): dv's z counts in
+// the shift, as on the CPU.
+fn pushed(x: vec2<i32>, dv: array<vec2<u32>, 3>) -> vec2<i32> {
     var sum: array<vec2<u32>, 3>;
-    var m = 0u;
     var top = 0u;
     for (var k = 0u; k < 3u; k++) {
         var xk = vec2<u32>(0u, 0u);
         if k < 2u {
             xk = vec2<u32>(bitcast<u32>(x[k]), select(0u, 0xffffffffu, x[k] < 0));
         }
-        sum[k] = add64(xk, vec2<u32>(params[16u + 2u * k], params[17u + 2u * k]));
-        var magnitude = sum[k];
-        if (magnitude.y >> 31u) != 0u {
-            magnitude = add64(~magnitude, vec2<u32>(1u, 0u));
-        }
-        top = max(top, bitlen64(magnitude));
+        sum[k] = add64(xk, dv[k]);
+        top = max(top, bitlen64(select(sum[k], neg64(sum[k]), is_negative64(sum[k]))));
     }
     let shift = max(top, 30u) - 30u;
     var out: vec2<i32>;
@@ -381,6 +472,21 @@ fn pushed(x: vec2<i32>) -> vec2<i32> {
         }
     }
     return out;
+}
+
+// M5.1's push on the particle in cell (x, y): G (params[16..22]) and the
+// vortex where it is on (params[27]).
+fn push_at(x: u32, y: u32) -> array<vec2<u32>, 3> {
+    var dv: array<vec2<u32>, 3>;
+    for (var k = 0u; k < 3u; k++) {
+        dv[k] = vec2<u32>(params[16u + 2u * k], params[17u + 2u * k]);
+    }
+    if params[27] != 0u {
+        let t = swirl(x, y);
+        dv[0] = add64(dv[0], t[0]);
+        dv[1] = add64(dv[1], t[1]);
+    }
+    return dv;
 }
 
 // Eqs. 7-8 for the pair (a, c) with working velocities xa, xc and
@@ -437,16 +543,20 @@ fn collide(xa: vec2<i32>, xc: vec2<i32>, out: ptr<function, array<vec2<i32>, 2>>
     return true;
 }
 
-// M5.1 on every particle (where G is not 0), M5.2 on the block's pair,
+// M5.1 on every particle (where a force is on), M5.2 on the block's pair,
 // then M1 for every velocity they changed, in cell order.
-fn change(b: ptr<function, Block>, s: ptr<function, Stream>, counts: ptr<function, Counts>) {
+fn change(b: ptr<function, Block>, at: array<vec2<u32>, 4>, s: ptr<function, Stream>, counts: ptr<function, Counts>) {
     var x: array<vec2<i32>, 4>;
     var changed = 0u;
     for (var c = 0u; c < 4u; c++) {
         x[c] = (*b).v[c] << vec2<u32>(fine());
         if params[22] != 0u && ((*b).occ >> c & 1u) != 0u {
-            x[c] = clamp_speed(pushed(x[c]), counts);
-            changed |= 1u << c;
+            // A push of exactly zero touches nothing (M5.1).
+            let dv = push_at(at[c].x, at[c].y);
+            if !is_zero64(dv[0] | dv[1] | dv[2]) {
+                x[c] = clamp_speed(pushed(x[c], dv), counts);
+                changed |= 1u << c;
+            }
         }
     }
     // M5.2's pair, the block's first draw.
@@ -792,7 +902,11 @@ fn step_2d(@builtin(global_invocation_id) id: vec3<u32>) {
         s.gamma = sk.gamma;
         s.pool = vec2<u32>(0u, 0u);
         s.left = 0u;
-        change(&b, &s, &block_counts);
+        var at: array<vec2<u32>, 4>;
+        for (var c = 0u; c < 4u; c++) {
+            at[c] = vec2<u32>(cols[c & 1u].at, rows[c >> 1u].at);
+        }
+        change(&b, at, &s, &block_counts);
         let want = desire(&b, &site, &s, &block_counts);
         let targets = assign(&b, site.wall, want, &s, &block_counts);
         if params[26] != 0u && want != 0u {
@@ -858,6 +972,107 @@ fn step_2d(@builtin(global_invocation_id) id: vec3<u32>) {
     }
 }
 
+// M6, once a step before its sweep, in one invocation: each emitter in
+// turn asks for the whole part of its rate and one more where 24 random
+// bits fall below its threshold, and places them in a uniform choice of
+// the free cells of its region (selection sampling, walking the region in
+// cell order), each with its velocity, spread over the disc of its radius
+// (16-bit draws until inside), clamped uncounted and rounded (M1, one
+// 64-bit output), from its stream of (seed, step, emitter).
+@compute @workgroup_size(1)
+fn emit() {
+    let step = vec2<u32>(atomicLoad(&counters[13]), atomicLoad(&counters[14]));
+    let seed = vec2<u32>(params[0], params[1]);
+    // M8's emitter streams: their own domain, 2^32 counters an emitter.
+    let a = mix64(seed ^ vec2<u32>(0x656d6900u, 0x6d706361u));
+    let key = mix64(a ^ mul64(step, vec2<u32>(0x7f4a7c15u, 0x9e3779b9u)));
+    var gamma = mix64(key ^ vec2<u32>(0x78bd642fu, 0xa0761d64u)) | vec2<u32>(1u, 0u);
+    let t = gamma ^ shr64(gamma, 1u);
+    if countOneBits(t.x) + countOneBits(t.y) < 24u {
+        gamma = gamma ^ vec2<u32>(0xaaaaaaaau, 0xaaaaaaaau);
+    }
+    let nx = params[6];
+    let row_u32 = params[8];
+    let unit = params[11];
+    for (var i = 0u; i < params[35]; i++) {
+        let e = 16u * i;
+        var s: Stream;
+        s.counter = add64(key, vec2<u32>(0u, gamma.x * i));
+        s.gamma = gamma;
+        s.pool = vec2<u32>(0u, 0u);
+        s.left = 0u;
+        var wanted = vec2<u32>(emitters[e + 4u], emitters[e + 5u]);
+        if bits(&s, 24u) < emitters[e + 6u] && !all(wanted == vec2<u32>(0xffffffffu)) {
+            wanted = add64(wanted, vec2<u32>(1u, 0u));
+        }
+        if is_zero64(wanted) {
+            continue;
+        }
+        var free = 0u;
+        for (var y = emitters[e + 1u]; y < emitters[e + 3u]; y++) {
+            for (var x = emitters[e]; x < emitters[e + 2u]; x++) {
+                free += 1u - (occ_emit[y * row_u32 + (x >> 5u)] >> (x & 31u) & 1u);
+            }
+        }
+        let placing = select(free, wanted.x, wanted.y == 0u && wanted.x < free);
+        var need = placing;
+        var left = free;
+        for (var y = emitters[e + 1u]; y < emitters[e + 3u]; y++) {
+            for (var x = emitters[e]; x < emitters[e + 2u]; x++) {
+                let word = y * row_u32 + (x >> 5u);
+                if need == 0u || (occ_emit[word] >> (x & 31u) & 1u) != 0u {
+                    continue;
+                }
+                let take = below(&s, left) < need;
+                left -= 1u;
+                if !take {
+                    continue;
+                }
+                need -= 1u;
+                var v = vec2<i32>(bitcast<i32>(emitters[e + 7u]), bitcast<i32>(emitters[e + 8u]));
+                let radius = bitcast<i32>(emitters[e + 9u]);
+                if radius > 0 {
+                    var p: vec2<i32>;
+                    loop {
+                        let xy = bits(&s, 32u);
+                        p = vec2<i32>(i32(xy & 0xffffu) - 32768, i32(xy >> 16u) - 32768);
+                        if !lt64(vec2<u32>(1u << 30u, 0u), sq2(p)) {
+                            break;
+                        }
+                    }
+                    v += vec2<i32>(mulq(p.x, radius, 15u), mulq(p.y, radius, 15u));
+                }
+                let s2 = sq2(v);
+                if lt64(mul32(unit, unit), s2) {
+                    v = shorten(v, s2);
+                }
+                let r = next64(&s);
+                let limit = select(127, 32767, wide());
+                let mask = (1u << fine()) - 1u;
+                let q = vec2<i32>(clamp((v.x + i32(r.x & mask)) >> fine(), -limit, limit), clamp((v.y + i32((r.x >> 16u) & mask)) >> fine(), -limit, limit));
+                occ_emit[word] |= 1u << (x & 31u);
+                let cell = y * nx + x;
+                if wide() {
+                    vel_emit[cell] = (u32(q.x) & 0xffffu) | u32(q.y) << 16u;
+                } else {
+                    let shift = 16u * (cell & 1u);
+                    let pair = (u32(q.x) & 0xffu) | (u32(q.y) & 0xffu) << 8u;
+                    vel_emit[cell >> 1u] = (vel_emit[cell >> 1u] & ~(0xffffu << shift)) | pair << shift;
+                }
+            }
+        }
+        add_wide(17u, sub64(wanted, vec2<u32>(placing, 0u)));
+        let at = 4u * i;
+        let requested = add64(vec2<u32>(emitter_stats[at], emitter_stats[at + 1u]), wanted);
+        let delivered = add64(vec2<u32>(emitter_stats[at + 2u], emitter_stats[at + 3u]), vec2<u32>(placing, 0u));
+        emitter_stats[at] = requested.x;
+        emitter_stats[at + 1u] = requested.y;
+        emitter_stats[at + 2u] = delivered.x;
+        emitter_stats[at + 3u] = delivered.y;
+        add_count(15u, placing);
+    }
+}
+
 // After a step's sweep: its processed blocks become the last step's, and
 // the step number advances (M3's parity with it).
 @compute @workgroup_size(1)
@@ -878,6 +1093,9 @@ fn add_count(at: u32, n: u32) {
     }
 }
 
+// Adds a 64-bit n to the counter pair at `at`; a carry out of the pair
+// sets the clamp energy's saturation flag where `at` is that counter (the
+// others cannot reach 2^64).
 fn add_wide(at: u32, n: vec2<u32>) {
     if is_zero64(n) {
         return;
@@ -887,7 +1105,7 @@ fn add_wide(at: u32, n: vec2<u32>) {
     let high = n.y + carry;
     if high != 0u {
         let before = atomicAdd(&counters[at + 1u], high);
-        if before + high < before {
+        if before + high < before && at == 4u {
             atomicOr(&counters[11], 1u);
         }
     }

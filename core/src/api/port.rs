@@ -8,7 +8,9 @@
 //! world.
 
 use crate::api::desc::Drift;
-use crate::rules::fixed::{csqrt, magnitude, parts, scaled, scaled_by};
+use crate::rules::emitter::{split_rate, EmitterStats};
+use crate::rules::fixed::{csqrt, magnitude, parts, scaled, scaled_by, to_fine, unit_scale};
+use crate::rules::force::Swirl;
 use crate::rules::quant::Quant;
 use crate::rules::rng::StepKey;
 use crate::step::convert_class;
@@ -49,6 +51,42 @@ pub struct StepConstants {
     /// M5.3: per stored 8-bit component (as a byte), the largest 16
     /// random bits that say "move".
     pub moves: &'static [u16; 256],
+    /// M5.1's Rankine vortex force, where it is on (M1c).
+    pub vortex: Option<VortexConstants>,
+}
+
+/// M5.1's vortex as the step reads it (M1c): its centre and core radius
+/// in `2^-8` cells, and its strength for the world's mass as `top(Γ')`, a
+/// 16-bit significand `g` (signed) and an exponent `e`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct VortexConstants {
+    /// See the type.
+    pub centre: [i64; 2],
+    /// See the type.
+    pub core: u32,
+    /// See the type.
+    pub g: i32,
+    /// See the type.
+    pub e: i32,
+}
+
+/// An emitter as a step reads it (M6, M1c).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct EmitterConstants {
+    /// Its region: cells `min[k] <= x_k < max[k]`.
+    pub min: [u32; 3],
+    /// See `min`.
+    pub max: [u32; 3],
+    /// The whole part of its rate (`u64::MAX` for an absurd one).
+    pub whole: u64,
+    /// One more particle where 24 random bits fall below this.
+    pub threshold: u32,
+    /// Its velocity in fine units, `conv(v_k, W, 0)`.
+    pub velocity: [i32; 3],
+    /// Its spread in fine units, `conv(spread, W, 0)`.
+    pub radius: i32,
+    /// Steps its particles live, 0 for ever.
+    pub lifetime: u32,
 }
 
 /// What steps run elsewhere counted (the fields of [`crate::Stats`] of the
@@ -67,6 +105,10 @@ pub struct StepCounts {
     pub displaced: u64,
     /// Over those steps.
     pub exited: u64,
+    /// Over those steps.
+    pub emitted: u64,
+    /// Over those steps (`Stats::emit_shortfall`).
+    pub shortfall: u64,
     /// In the last of those steps.
     pub blocks_processed: u64,
 }
@@ -107,7 +149,29 @@ impl World {
             fine,
             energy: (m as u32, e),
             moves: crate::rules::quant::move_table_8(desc.drift),
+            vortex: (cfg!(feature = "vortex") && desc.forces.vortex).then(|| {
+                let swirl = Swirl::of(&desc.vortex);
+                let (centre, core) = swirl.integers();
+                let strength = swirl.gamma(class.push, (s as u32, fine as i32));
+                VortexConstants { centre, core, g: strength.g, e: strength.e }
+            }),
         }
+    }
+
+    /// Emitter `i` as a step reads it (M6, M1c), `None` past the last.
+    pub fn port_emitter(&self, i: usize) -> Option<EmitterConstants> {
+        let e = self.slots().get(i)?.emitter;
+        let scale = unit_scale(crate::rules::quant::unit_of(self.head.desc.quantization));
+        let (whole, threshold) = split_rate(e.rate);
+        Some(EmitterConstants {
+            min: e.min,
+            max: e.max,
+            whole,
+            threshold,
+            velocity: e.velocity.map(|v| to_fine(v, scale)),
+            radius: to_fine(e.spread, scale),
+            lifetime: e.lifetime,
+        })
     }
 
     /// The occupancy and velocity planes, to copy a world out.
@@ -119,7 +183,9 @@ impl World {
     /// Takes the world `c.steps` steps that ran elsewhere left: its
     /// occupancy and velocities as [`World::port_planes`] lays them out,
     /// and what those steps counted (their counters added, the last step's
-    /// processed and skipped blocks set, the step number advanced).
+    /// processed and skipped blocks set, the step number advanced), with
+    /// what each emitter asked for and placed in them (`emitters`, one
+    /// entry an emitter).
     ///
     /// Refused, with the world unchanged: planes of the wrong length
     /// (`BadLength`); a world whose particles carry more than a velocity
@@ -128,10 +194,10 @@ impl World {
     /// particle on an obstacle, a stored component beyond the storage's
     /// range, or a particle count other than the world's less the exits
     /// (`ImageInvalid`).
-    pub fn port_finish_steps(&mut self, occupancy: &[u64], velocity: &[u8], c: &StepCounts) -> Result<(), Error> {
+    pub fn port_finish_steps(&mut self, occupancy: &[u64], velocity: &[u8], c: &StepCounts, emitters: &[EmitterStats]) -> Result<(), Error> {
         let l = *self.layout();
         let desc = self.head.desc;
-        if occupancy.len() * 8 != l.occupancy().len || velocity.len() != l.velocity().len {
+        if occupancy.len() * 8 != l.occupancy().len || velocity.len() != l.velocity().len || emitters.len() != self.slots().len() {
             return Err(Error::BadLength);
         }
         if desc.has_masses() || desc.lifetimes || desc.identity_planes().any() {
@@ -165,10 +231,14 @@ impl World {
                 }
             }
         }
-        if Some(count) != self.head.counters.particles.checked_sub(c.exited) {
+        if Some(count) != self.head.counters.particles.checked_add(c.emitted).and_then(|n| n.checked_sub(c.exited)) {
             return Err(Error::ImageInvalid);
         }
         let (_, p) = self.planes::<u8>();
+        for (slot, more) in p.emitters.iter_mut().zip(emitters) {
+            slot.stats.requested = slot.stats.requested.saturating_add(more.requested);
+            slot.stats.delivered = slot.stats.delivered.saturating_add(more.delivered);
+        }
         p.occupancy.copy_from_slice(occupancy);
         p.velocity.copy_from_slice(velocity);
         // The step's summaries of empty rows and words (M3): "may hold a
@@ -196,7 +266,9 @@ impl World {
             displaced: c.displaced,
             ..Counters::default()
         });
-        h.particles = h.particles.saturating_sub(c.exited);
+        h.emitted = h.emitted.saturating_add(c.emitted);
+        h.shortfall = h.shortfall.saturating_add(c.shortfall);
+        h.particles = h.particles.saturating_add(c.emitted).saturating_sub(c.exited);
         h.processed = c.blocks_processed;
         h.skipped = total.saturating_sub(c.blocks_processed);
         self.head.step = self.head.step.wrapping_add(c.steps);

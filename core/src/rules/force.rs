@@ -142,9 +142,9 @@ const REACH: i64 = 1 << 28;
 #[repr(C)]
 pub(crate) struct Strength {
     /// The top 16 bits of the magnitude, with the strength's sign.
-    g: i32,
+    pub(crate) g: i32,
     /// The place of `g`'s lowest bit.
-    e: i32,
+    pub(crate) e: i32,
 }
 
 impl Strength {
@@ -177,6 +177,12 @@ impl Swirl {
     /// The strength in fine units per `2^-8` cell for a factor `k` in a
     /// world whose unit speed is `(s, fine)` ([`unit_scale`](crate::rules::fixed::unit_scale)):
     /// M1c's `top(conv(G / (2 pi), k W, 8))`.
+    /// The centre (`2^-8` cells) and the core radius (`2^-8` cells) as
+    /// the step reads them, for a second implementation (`port`).
+    pub(crate) fn integers(&self) -> ([i64; 2], u32) {
+        (self.centre, self.core)
+    }
+
     #[inline]
     pub(crate) fn gamma(&self, k: f32, (s, fine): (u32, i32)) -> Strength {
         Strength::of(scaled_by(self.strength, k, s, fine + 8))
