@@ -15,10 +15,11 @@
 //! mass on any faces: the uniform force and the vortex (M5.1), collisions
 //! (M5.2 and M5.2b, any restitution), both drift rules (M5.3), reflection
 //! off walls (M5.4), the exact-fast assignment (M5.6), contacts (M5.7),
-//! exits through open faces and emitters (M6): the paper's aggregation,
-//! cluster and smoke scenes and the benchmark's gas. A description that
-//! needs any other part is refused when the world is made, as a CPU build
-//! without that part refuses it ([`mpca::Error::FeatureDisabled`]).
+//! exits through open faces, emitters and lifetimes (M6): the paper's
+//! aggregation, cluster and smoke scenes and the benchmark's gas. A
+//! description that needs any other part is refused when the world is made,
+//! as a CPU build without that part refuses it
+//! ([`mpca::Error::FeatureDisabled`]).
 //!
 //! ```
 //! use mpca::{Description, WorldBox};
@@ -43,7 +44,7 @@
 mod export;
 
 pub use export::Exports;
-use mpca::port::{StepConstants, StepCounts, VortexConstants};
+use mpca::port::{PortPlanes, StepConstants, StepCounts, VortexConstants};
 use mpca::{Boundary, Collisions, Description, Drift, Identity, Method, Quantization, World, WorldBox};
 use wgpu::util::DeviceExt;
 
@@ -130,7 +131,7 @@ impl Gpu {
 
 /// Why this backend cannot run a description: `None` where it can.
 pub fn unsupported(d: &Description) -> Option<&'static str> {
-    let checks: [(bool, &'static str); 9] = [
+    let checks: [(bool, &'static str); 8] = [
         (d.dim == 2, "3D worlds"),
         (!d.per_particle_mass, "per-particle masses"),
         (!d.obstacles, "obstacles"),
@@ -138,7 +139,6 @@ pub fn unsupported(d: &Description) -> Option<&'static str> {
         (d.drag.rate == 0.0, "flow drag"),
         (d.method == Method::ExactFast, "an assignment other than exact-fast"),
         (!d.energy_neutral, "energy-neutral rounding"),
-        (!d.lifetimes, "lifetimes"),
         (d.identity == Identity::NONE, "ids, ages and tags"),
     ];
     checks.iter().find(|(ok, _)| !ok).map(|(_, what)| *what)
@@ -176,14 +176,16 @@ fn tables(moves: &[u16; 256]) -> Vec<u32> {
 /// energy, displaced, exited; the blocks processed in the step; a flag for
 /// a saturated clamp energy; the blocks processed in the last step; the
 /// number of the step the world takes next (low, high); pairs of the
-/// particles emitted and the emitters' shortfall.
-const COUNTERS: usize = 19;
+/// particles emitted, the emitters' shortfall and the particles whose
+/// lifetime ended.
+const COUNTERS: usize = 21;
 /// Words an emitter takes in the shader's emitter table.
 const EMITTER: usize = 16;
 /// The counters a sync takes into the CPU copy and clears: all but the
 /// step number.
 const COUNTED: usize = 13;
-/// Where the emitted particles and the shortfall lie in the counters.
+/// Where the emitted particles, the shortfall and the expired lie in the
+/// counters.
 const EMITTED: usize = 15;
 
 /// A world stepped on the GPU, equal to the CPU's bit for bit.
@@ -209,6 +211,8 @@ pub struct GpuWorld {
     end_group: wgpu::BindGroup,
     occupancy: [wgpu::Buffer; 2],
     velocity: [wgpu::Buffer; 2],
+    /// The lifetimes (M6), where the world has them (a word otherwise).
+    life: [wgpu::Buffer; 2],
     counters: wgpu::Buffer,
     /// `groups[i]` reads pair member `i` and writes the other.
     groups: [wgpu::BindGroup; 2],
@@ -234,11 +238,12 @@ impl GpuWorld {
         let desc = *host.description();
         let (nx, ny) = (desc.size[0], desc.size[1]);
         let p = host.port_planes();
-        let (occupancy, velocity) = (bytemuck::cast_slice::<u64, u8>(p.occupancy).to_vec(), p.velocity.to_vec());
+        let (occupancy, velocity, life) = (bytemuck::cast_slice::<u64, u8>(p.occupancy).to_vec(), p.velocity.to_vec(), p.life.to_vec());
         let storage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
         let buffer = |label: &str, bytes: &[u8]| device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents: &padded(bytes), usage: storage });
         let occupancy = [buffer("occupancy 0", &occupancy), buffer("occupancy 1", &occupancy)];
         let velocity = [buffer("velocity 0", &velocity), buffer("velocity 1", &velocity)];
+        let life = [buffer("life 0", &life), buffer("life 1", &life)];
         let counters = buffer("counters", bytemuck::cast_slice(&counters_of(&host)));
         let params = buffer("params", bytemuck::cast_slice(&params(&host.port_constants(), &desc, emitter_count(&host) as u32)));
         let tables = buffer("tables", bytemuck::cast_slice(&tables(mpca::port::move_table_8(desc.drift))));
@@ -263,7 +268,7 @@ impl GpuWorld {
             let pipeline = pipeline_of("emit");
             let layout = pipeline.get_bind_group_layout(0);
             let group = |member: usize| {
-                let entries = [(0, &params), (6, &counters), (7, &occupancy[member]), (8, &velocity[member]), (9, &emitters), (10, &emitter_stats)];
+                let entries = [(0, &params), (6, &counters), (7, &occupancy[member]), (8, &velocity[member]), (9, &emitters), (10, &emitter_stats), (13, &life[member])];
                 let entries: Vec<wgpu::BindGroupEntry<'_>> = entries.iter().map(|&(binding, b)| wgpu::BindGroupEntry { binding, resource: b.as_entire_binding() }).collect();
                 device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("emit"), layout: &layout, entries: &entries })
             };
@@ -277,8 +282,8 @@ impl GpuWorld {
         let layout = pipeline.get_bind_group_layout(0);
         let group = |from: usize| {
             let to = 1 - from;
-            let entries = [&params, &tables, &occupancy[from], &velocity[from], &occupancy[to], &velocity[to], &counters];
-            let entries: Vec<wgpu::BindGroupEntry<'_>> = entries.iter().enumerate().map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() }).collect();
+            let entries = [(0, &params), (1, &tables), (2, &occupancy[from]), (3, &velocity[from]), (4, &occupancy[to]), (5, &velocity[to]), (6, &counters), (11, &life[from]), (12, &life[to])];
+            let entries: Vec<wgpu::BindGroupEntry<'_>> = entries.iter().map(|&(binding, b)| wgpu::BindGroupEntry { binding, resource: b.as_entire_binding() }).collect();
             device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("step"), layout: &layout, entries: &entries })
         };
         let groups = [group(0), group(1)];
@@ -297,6 +302,7 @@ impl GpuWorld {
             end_group,
             occupancy,
             velocity,
+            life,
             counters,
             groups,
             current: 0,
@@ -328,6 +334,7 @@ impl GpuWorld {
         let p = host.port_planes();
         queue.write_buffer(&self.occupancy[self.current], 0, bytemuck::cast_slice(p.occupancy));
         queue.write_buffer(&self.velocity[self.current], 0, &padded(p.velocity));
+        queue.write_buffer(&self.life[self.current], 0, &padded(p.life));
         queue.write_buffer(&self.counters, 0, bytemuck::cast_slice(&counters_of(&host)));
         queue.write_buffer(&self.params, 0, bytemuck::cast_slice(&params(&host.port_constants(), &desc, emitter_count(&host) as u32)));
         queue.write_buffer(&self.tables, 0, bytemuck::cast_slice(&tables(mpca::port::move_table_8(desc.drift))));
@@ -383,12 +390,16 @@ impl GpuWorld {
         if self.pending > 0 {
             let occupancy: Vec<u64> = self.gpu.read(&self.occupancy[self.current]).chunks_exact(8).map(|b| u64::from_le_bytes(b.try_into().expect("8 bytes"))).collect();
             let mut velocity = self.gpu.read(&self.velocity[self.current]);
+            let mut life = self.gpu.read(&self.life[self.current]);
             let counters: Vec<u32> = bytemuck::cast_slice(&self.gpu.read(&self.counters)).to_vec();
             let stats: Vec<u64> = bytemuck::cast_slice::<u8, u32>(&self.gpu.read(&self.emitter_stats)).chunks_exact(2).map(|w| u64::from(w[0]) | u64::from(w[1]) << 32).collect();
             let emitters = emitter_count(&self.host);
             let emitted: Vec<mpca::EmitterStats> = (0..emitters).map(|i| mpca::EmitterStats { requested: stats[2 * i], delivered: stats[2 * i + 1] }).collect();
-            // The buffer is padded to whole words.
-            velocity.truncate(self.host.port_planes().velocity.len());
+            // The buffers are padded to whole words.
+            let planes = self.host.port_planes();
+            velocity.truncate(planes.velocity.len());
+            life.truncate(planes.life.len());
+            let row_words = planes.row_words;
             let wide = |i: usize| u64::from(counters[i]) | u64::from(counters[i + 1]) << 32;
             if wide(13) != self.host.stats().step.wrapping_add(self.pending) {
                 return Err(Error::Unsubmitted);
@@ -403,11 +414,12 @@ impl GpuWorld {
                 blocks_processed: u64::from(counters[12]),
                 emitted: wide(EMITTED),
                 shortfall: wide(EMITTED + 2),
+                expired: wide(EMITTED + 4),
             };
-            self.host.port_finish_steps(&occupancy, &velocity, &counts, &emitted)?;
+            self.host.port_finish_steps(&PortPlanes { occupancy: &occupancy, row_words, velocity: &velocity, life: &life }, &counts, &emitted)?;
             // Counted into the CPU copy: the GPU's start again from zero.
             self.gpu.queue.write_buffer(&self.counters, 0, &[0u8; 4 * COUNTED]);
-            self.gpu.queue.write_buffer(&self.counters, 4 * EMITTED as u64, &[0u8; 16]);
+            self.gpu.queue.write_buffer(&self.counters, 4 * EMITTED as u64, &[0u8; 24]);
             self.gpu.queue.write_buffer(&self.emitter_stats, 0, &vec![0u8; self.emitter_stats.size() as usize]);
             self.pending = 0;
         }
@@ -434,7 +446,7 @@ fn emitter_table(host: &World, capacity: usize) -> Vec<u32> {
     let mut table = vec![0u32; EMITTER * capacity];
     for (i, entry) in table.chunks_exact_mut(EMITTER).enumerate() {
         let Some(e) = host.port_emitter(i) else { break };
-        entry[..10].copy_from_slice(&[e.min[0], e.min[1], e.max[0], e.max[1], e.whole as u32, (e.whole >> 32) as u32, e.threshold, e.velocity[0] as u32, e.velocity[1] as u32, e.radius as u32]);
+        entry[..11].copy_from_slice(&[e.min[0], e.min[1], e.max[0], e.max[1], e.whole as u32, (e.whole >> 32) as u32, e.threshold, e.velocity[0] as u32, e.velocity[1] as u32, e.radius as u32, e.lifetime]);
     }
     table
 }
@@ -449,7 +461,7 @@ fn counters_of(host: &World) -> [u32; COUNTERS] {
 }
 
 /// The shader's parameters (`step2d.wgsl`).
-const PARAMS: usize = 36;
+const PARAMS: usize = 37;
 
 /// A face as the shader reads it: 0 periodic, 1 wall, 2 open.
 fn face(b: Boundary) -> u32 {
@@ -506,5 +518,6 @@ fn params(c: &StepConstants, d: &Description, d_emitters: u32) -> [u32; PARAMS] 
         v.g as u32,
         v.e as u32,
         d_emitters,
+        u32::from(d.lifetimes),
     ]
 }

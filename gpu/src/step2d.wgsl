@@ -20,7 +20,7 @@
 // collisions (M5.2b), 25 their limit L (fine units), 26 contacts (M5.7),
 // 27 the vortex force (M5.1), 28-31 its centre (x, y as 64-bit pairs,
 // 2^-8 cells), 32 its core (2^-8 cells), 33-34 its strength top(Γ') (g,
-// e), 35 the emitters.
+// e), 35 the emitters, 36 lifetimes.
 @group(0) @binding(0) var<storage, read> params: array<u32>;
 // tables: 0..256 M5.3 move limits; 256..2304 the turns of M5.2 (cos, sin
 // as i32); 2304..3600 per 2D key its assignments (start | count << 16,
@@ -34,17 +34,24 @@
 // displaced, exited; 10 blocks processed in this step; 11 the clamp energy
 // saturated; 12 blocks processed in the last step; 13-14 the number of the
 // step the world takes next, which `end_step` advances; pairs of the
-// particles emitted (15) and the emitters' shortfall (17).
+// particles emitted (15), the emitters' shortfall (17) and the particles
+// whose lifetime ended (19).
 @group(0) @binding(6) var<storage, read_write> counters: array<atomic<u32>>;
 // The emitters' pass (`emit`) writes the planes the step then reads.
 @group(0) @binding(7) var<storage, read_write> occ_emit: array<u32>;
 @group(0) @binding(8) var<storage, read_write> vel_emit: array<u32>;
 // Per emitter (M6), 16 words: min x, min y, max x, max y, the rate's whole
 // part (64 bits), its 24-bit threshold, velocity x, y and spread (fine
-// units).
+// units), the lifetime of its particles.
 @group(0) @binding(9) var<storage, read> emitters: array<u32>;
 // Per emitter, 4 words: requested, delivered (64-bit pairs).
 @group(0) @binding(10) var<storage, read_write> emitter_stats: array<u32>;
+// The steps each particle has left (M6, 0 for no limit), two cells a
+// word, where the world has lifetimes (params[36]): what the step reads,
+// what it writes, and what the emitters write.
+@group(0) @binding(11) var<storage, read> life_in: array<u32>;
+@group(0) @binding(12) var<storage, read_write> life_out: array<u32>;
+@group(0) @binding(13) var<storage, read_write> life_emit: array<u32>;
 
 const TURNS_AT: u32 = 256u;
 const KEYS_AT: u32 = 2304u;
@@ -278,6 +285,7 @@ struct Counts {
     displaced: u32,
     processed: u32,
     exited: u32,
+    expired: u32,
 }
 
 // M5.5: x clamped to the unit speed, counted.
@@ -360,6 +368,8 @@ fn move_limit_16(q: i32) -> u32 {
 struct Block {
     occ: u32,
     v: array<vec2<i32>, 4>,
+    // Steps left (M6), where the world has lifetimes.
+    life: array<u32, 4>,
 }
 
 // Where a block lies (M3, M4): its cells beyond a wall face (with their
@@ -840,13 +850,19 @@ fn step_2d(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     var out_occ = array<u32, 2>(0u, 0u);
-    // The words of velocities it owns in each row: 16 (8-bit) or 32.
+    // The words of velocities it owns in each row: 16 (8-bit) or 32; of
+    // lifetimes, 16.
     var out_vel: array<array<u32, 32>, 2>;
+    var out_life: array<array<u32, 16>, 2>;
     for (var i = 0u; i < 32u; i++) {
         out_vel[0][i] = 0u;
         out_vel[1][i] = 0u;
     }
-    var counts = Counts(0u, 0u, vec2<u32>(0u, 0u), false, 0u, 0u, 0u);
+    for (var i = 0u; i < 16u; i++) {
+        out_life[0][i] = 0u;
+        out_life[1][i] = 0u;
+    }
+    var counts = Counts(0u, 0u, vec2<u32>(0u, 0u), false, 0u, 0u, 0u, 0u);
     let sk = step_key(vec2<u32>(params[0], params[1]), step);
     // The blocks with a cell in [lo, hi): x0 + 1 >= lo and x0 < hi.
     let bx_lo = (i32(lo) - first.x) >> 1u;
@@ -877,10 +893,15 @@ fn step_2d(@builtin(global_invocation_id) id: vec3<u32>) {
             let row = rows[c >> 1u];
             b.v[c] = vec2<i32>(0, 0);
             site.normal[c] = vec2<i32>(0, 0);
+            b.life[c] = 0u;
             if col.kind == 0u && row.kind == 0u {
                 if occupied(col.at, row.at) != 0u {
                     b.occ |= 1u << c;
                     b.v[c] = velocity(col.at, row.at);
+                    if params[36] != 0u {
+                        let i = row.at * nx + col.at;
+                        b.life[c] = life_in[i >> 1u] >> (16u * (i & 1u)) & 0xffffu;
+                    }
                 }
             } else if col.kind == 1u || row.kind == 1u {
                 // A corner beyond a wall and an open face is a wall; its
@@ -895,7 +916,7 @@ fn step_2d(@builtin(global_invocation_id) id: vec3<u32>) {
         if b.occ == 0u {
             continue;
         }
-        var block_counts = Counts(0u, 0u, vec2<u32>(0u, 0u), false, 0u, 1u, 0u);
+        var block_counts = Counts(0u, 0u, vec2<u32>(0u, 0u), false, 0u, 1u, 0u, 0u);
         let index = u32(bx) + blocks.x * r;
         var s: Stream;
         s.counter = add64(sk.key, mul64(sk.stride, vec2<u32>(index, 0u)));
@@ -921,6 +942,10 @@ fn step_2d(@builtin(global_invocation_id) id: vec3<u32>) {
                 block_counts.exited += 1u; // M4: through an open face
                 continue;
             }
+            if b.life[c] == 1u {
+                block_counts.expired += 1u; // M6: its last step
+                continue;
+            }
             let x = cols[t & 1u].at;
             if x < lo || x >= hi {
                 continue;
@@ -933,6 +958,7 @@ fn step_2d(@builtin(global_invocation_id) id: vec3<u32>) {
                 let byte_pair = (u32(b.v[c].x) & 0xffu) | (u32(b.v[c].y) & 0xffu) << 8u;
                 out_vel[row][(x - lo) >> 1u] |= byte_pair << (16u * (x & 1u));
             }
+            out_life[row][(x - lo) >> 1u] |= (max(b.life[c], 1u) - 1u) << (16u * (x & 1u));
         }
         // Counted by the invocation that owns the block's first cell inside.
         let owner = u32(max(x0, 0));
@@ -944,6 +970,7 @@ fn step_2d(@builtin(global_invocation_id) id: vec3<u32>) {
             counts.energy = total;
             counts.displaced += block_counts.displaced;
             counts.exited += block_counts.exited;
+            counts.expired += block_counts.expired;
             counts.processed += 1u;
         }
     }
@@ -958,6 +985,12 @@ fn step_2d(@builtin(global_invocation_id) id: vec3<u32>) {
         for (var k = 0u; k < words; k++) {
             vel_out[base + k] = out_vel[row][k];
         }
+        if params[36] != 0u {
+            let first = (rows[row].at * nx + lo) >> 1u;
+            for (var k = 0u; k < (hi - lo) / 2u; k++) {
+                life_out[first + k] = out_life[row][k];
+            }
+        }
     }
     add_count(0u, counts.collisions);
     add_count(2u, counts.clamps);
@@ -967,6 +1000,7 @@ fn step_2d(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     add_count(6u, counts.displaced);
     add_count(8u, counts.exited);
+    add_count(19u, counts.expired);
     if counts.processed != 0u {
         atomicAdd(&counters[10], counts.processed);
     }
@@ -1058,6 +1092,10 @@ fn emit() {
                     let shift = 16u * (cell & 1u);
                     let pair = (u32(q.x) & 0xffu) | (u32(q.y) & 0xffu) << 8u;
                     vel_emit[cell >> 1u] = (vel_emit[cell >> 1u] & ~(0xffffu << shift)) | pair << shift;
+                }
+                if params[36] != 0u {
+                    let shift = 16u * (cell & 1u);
+                    life_emit[cell >> 1u] = (life_emit[cell >> 1u] & ~(0xffffu << shift)) | (emitters[e + 10u] & 0xffffu) << shift;
                 }
             }
         }

@@ -148,44 +148,51 @@ fn planes_that_are_not_a_world_are_refused_and_change_nothing() {
     // mpca::World::port_finish_steps, which the sync goes through: each
     // damaged plane is refused with the world's hash and statistics as
     // they were; the planes as they are pass.
-    use mpca::port::StepCounts;
+    use mpca::port::{PortPlanes, StepCounts};
     let mut w = gas(66, 6, 0.4, 3, |_| {});
-    let (occupancy, velocity) = {
+    let (occupancy, velocity, row_words) = {
         let p = w.port_planes();
-        (p.occupancy.to_vec(), p.velocity.to_vec())
+        (p.occupancy.to_vec(), p.velocity.to_vec(), p.row_words)
     };
     let (hash, stats) = (w.state_hash(), w.stats());
     let one = StepCounts { steps: 1, ..StepCounts::default() };
     let first = occupancy.iter().position(|&o| o != 0).unwrap();
     let cell = 64 * first + occupancy[first].trailing_zeros() as usize;
-    let mut cases: Vec<(Vec<u64>, Vec<u8>, StepCounts, mpca::Error)> = Vec::new();
-    cases.push((occupancy[1..].to_vec(), velocity.clone(), one, mpca::Error::BadLength));
-    cases.push((occupancy.clone(), velocity[1..].to_vec(), one, mpca::Error::BadLength));
+    // Occupancy, velocities, lifetimes, and the refusal they get.
+    type Case = (Vec<u64>, Vec<u8>, &'static [u8], mpca::Error);
+    let mut cases: Vec<Case> = Vec::new();
+    cases.push((occupancy[1..].to_vec(), velocity.clone(), &[], mpca::Error::BadLength));
+    cases.push((occupancy.clone(), velocity[1..].to_vec(), &[], mpca::Error::BadLength));
+    // A lifetime plane in a world without lifetimes.
+    cases.push((occupancy.clone(), velocity.clone(), &[0, 0], mpca::Error::BadLength));
     let mut beyond = occupancy.clone();
     beyond[1] |= 1 << 63; // cell 127 of a 66-cell row
     beyond[first] &= beyond[first] - 1;
-    cases.push((beyond, velocity.clone(), one, mpca::Error::ImageInvalid));
+    cases.push((beyond, velocity.clone(), &[], mpca::Error::ImageInvalid));
     let mut fast = velocity.clone();
     fast[2 * (cell % 64 + 66 * (first / 2))] = 0x80; // -128: beyond -127
-    cases.push((occupancy.clone(), fast, one, mpca::Error::ImageInvalid));
+    cases.push((occupancy.clone(), fast, &[], mpca::Error::ImageInvalid));
     let mut lost = occupancy.clone();
     lost[first] &= lost[first] - 1;
-    cases.push((lost.clone(), velocity.clone(), one, mpca::Error::ImageInvalid));
-    for (o, v, c, want) in cases {
-        assert_eq!(w.port_finish_steps(&o, &v, &c, &[]), Err(want));
+    cases.push((lost.clone(), velocity.clone(), &[], mpca::Error::ImageInvalid));
+    for (o, v, life, want) in cases {
+        let planes = PortPlanes { occupancy: &o, row_words, velocity: &v, life };
+        assert_eq!(w.port_finish_steps(&planes, &one, &[]), Err(want));
         assert_eq!((w.state_hash(), w.stats()), (hash, stats));
     }
-    // One particle fewer is what one exit leaves.
-    w.port_finish_steps(&lost, &velocity, &StepCounts { steps: 1, exited: 1, ..StepCounts::default() }, &[]).unwrap();
+    // One particle fewer is what one exit (or one expiry) leaves.
+    let planes = PortPlanes { occupancy: &lost, row_words, velocity: &velocity, life: &[] };
+    w.port_finish_steps(&planes, &StepCounts { steps: 1, exited: 1, ..StepCounts::default() }, &[]).unwrap();
     assert_eq!(w.stats().particles, stats.particles - 1);
-    // A world whose particles carry a lifetime: the planes cannot say
+    // A world whose particles carry a mass index: the planes cannot say
     // where it went.
-    let mut aged = gas(8, 8, 0.4, 3, |d| d.lifetimes = true);
+    let mut heavy = gas(8, 8, 0.4, 3, |d| d.per_particle_mass = true);
     let (o, v) = {
-        let p = aged.port_planes();
+        let p = heavy.port_planes();
         (p.occupancy.to_vec(), p.velocity.to_vec())
     };
-    assert_eq!(aged.port_finish_steps(&o, &v, &one, &[]), Err(mpca::Error::NotEnabled));
+    let planes = PortPlanes { occupancy: &o, row_words: 1, velocity: &v, life: &[] };
+    assert_eq!(heavy.port_finish_steps(&planes, &one, &[]), Err(mpca::Error::NotEnabled));
 }
 
 #[test]
@@ -362,9 +369,10 @@ fn the_papers_smoke_scene_steps_as_on_the_cpu() {
 
 #[test]
 fn emitters_and_the_vortex_step_as_on_the_cpu() {
-    // Two emitters (one with a spread, one asking for more than its region
-    // holds, so it falls short), a vortex whose centre lies on a cell's
-    // corner and one off the grid, with gravity, at both widths.
+    // Two emitters (one with a spread and a lifetime, one asking for more
+    // than its region holds, so it falls short), a vortex whose centre lies
+    // on a cell's corner and one off the grid, with gravity, at both
+    // widths.
     for quantization in [mpca::Quantization::Bits8, mpca::Quantization::Bits16] {
         for centre in [[20.0, 12.0], [20.3, 300.0]] {
             let mut w = gas(40, 24, 0.1, 71, |d| {
@@ -375,12 +383,14 @@ fn emitters_and_the_vortex_step_as_on_the_cpu() {
                 d.forces.uniform = true;
                 d.gravity = [0.0, 0.003, 0.0];
                 d.emitter_capacity = 3;
+                d.lifetimes = true;
             });
-            let emitter = |min: [u32; 3], max: [u32; 3], rate: f32, spread: f32| mpca::Emitter { min, max, rate, velocity: [0.2, 0.3, 0.0], spread, mass: 1.0, lifetime: 0 };
-            w.add_emitter(emitter([2, 2, 0], [8, 5, 0], 1.7, 0.4)).unwrap();
-            w.add_emitter(emitter([30, 0, 0], [32, 2, 0], 6.5, 0.0)).unwrap();
+            let emitter = |min: [u32; 3], max: [u32; 3], rate: f32, spread: f32, lifetime: u32| mpca::Emitter { min, max, rate, velocity: [0.2, 0.3, 0.0], spread, mass: 1.0, lifetime };
+            w.add_emitter(emitter([2, 2, 0], [8, 5, 0], 1.7, 0.4, 7)).unwrap();
+            w.add_emitter(emitter([30, 0, 0], [32, 2, 0], 6.5, 0.0, 0)).unwrap();
             same_worlds(&mut w, 30, 1);
             assert!(w.stats().emit_shortfall > 0, "the second emitter falls short");
+            assert!(w.stats().expired > 0, "the first emitter's particles expire");
         }
     }
 }

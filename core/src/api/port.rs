@@ -106,6 +106,8 @@ pub struct StepCounts {
     /// Over those steps.
     pub exited: u64,
     /// Over those steps.
+    pub expired: u64,
+    /// Over those steps.
     pub emitted: u64,
     /// Over those steps (`Stats::emit_shortfall`).
     pub shortfall: u64,
@@ -121,9 +123,12 @@ pub struct PortPlanes<'a> {
     /// 64-bit words a row of the occupancy.
     pub row_words: usize,
     /// The stored velocity components, `dim` a cell in dense cell order,
-    /// one byte each (8-bit worlds) or two (16-bit, little-endian). What an
-    /// empty cell holds is never read.
+    /// one byte each (8-bit worlds) or two (16-bit, in the machine's byte
+    /// order, as every plane here). What an empty cell holds is never read.
     pub velocity: &'a [u8],
+    /// The steps each particle has left to live (M6), two bytes a cell (0
+    /// for no limit); empty in a world without lifetimes.
+    pub life: &'a [u8],
 }
 
 impl World {
@@ -174,33 +179,34 @@ impl World {
         })
     }
 
-    /// The occupancy and velocity planes, to copy a world out.
+    /// The occupancy, velocity and lifetime planes, to copy a world out.
     pub fn port_planes(&self) -> PortPlanes<'_> {
         let l = self.layout();
-        PortPlanes { occupancy: self.plane(l.occupancy()), row_words: l.row_words, velocity: self.plane_bytes(l.velocity()) }
+        PortPlanes { occupancy: self.plane(l.occupancy()), row_words: l.row_words, velocity: self.plane_bytes(l.velocity()), life: self.plane_bytes(l.life()) }
     }
 
     /// Takes the world `c.steps` steps that ran elsewhere left: its
-    /// occupancy and velocities as [`World::port_planes`] lays them out,
-    /// and what those steps counted (their counters added, the last step's
-    /// processed and skipped blocks set, the step number advanced), with
-    /// what each emitter asked for and placed in them (`emitters`, one
-    /// entry an emitter).
+    /// planes as [`World::port_planes`] lays them out, and what those steps
+    /// counted (their counters added, the last step's processed and
+    /// skipped blocks set, the step number advanced), with what each
+    /// emitter asked for and placed in them (`emitters`, one entry an
+    /// emitter).
     ///
     /// Refused, with the world unchanged: planes of the wrong length
     /// (`BadLength`); a world whose particles carry more than a velocity
-    /// (masses, lifetimes, ids, ages or tags: `NotEnabled`, since the
+    /// and a lifetime (masses, ids, ages or tags: `NotEnabled`, since the
     /// planes do not say where those went); a bit set beyond a row's end, a
     /// particle on an obstacle, a stored component beyond the storage's
-    /// range, or a particle count other than the world's less the exits
-    /// (`ImageInvalid`).
-    pub fn port_finish_steps(&mut self, occupancy: &[u64], velocity: &[u8], c: &StepCounts, emitters: &[EmitterStats]) -> Result<(), Error> {
+    /// range, or a particle count other than the world's with the emitted
+    /// and without the exits and expiries (`ImageInvalid`).
+    pub fn port_finish_steps(&mut self, planes: &PortPlanes<'_>, c: &StepCounts, emitters: &[EmitterStats]) -> Result<(), Error> {
         let l = *self.layout();
         let desc = self.head.desc;
-        if occupancy.len() * 8 != l.occupancy().len || velocity.len() != l.velocity().len || emitters.len() != self.slots().len() {
+        let PortPlanes { occupancy, velocity, life, .. } = *planes;
+        if occupancy.len() * 8 != l.occupancy().len || velocity.len() != l.velocity().len || life.len() != l.life().len || emitters.len() != self.slots().len() {
             return Err(Error::BadLength);
         }
-        if desc.has_masses() || desc.lifetimes || desc.identity_planes().any() {
+        if desc.has_masses() || desc.identity_planes().any() {
             return Err(Error::NotEnabled);
         }
         let obstacle: &[u64] = self.plane(l.obstacle());
@@ -224,14 +230,14 @@ impl World {
                 let cell = (i / l.row_words) * l.n[0] + x;
                 for k in 0..dim {
                     let at = cell * dim + k;
-                    let q = if wide { i32::from(i16::from_le_bytes([velocity[2 * at], velocity[2 * at + 1]])) } else { i32::from(velocity[at] as i8) };
+                    let q = if wide { i32::from(i16::from_ne_bytes([velocity[2 * at], velocity[2 * at + 1]])) } else { i32::from(velocity[at] as i8) };
                     if q.abs() > limit {
                         return Err(Error::ImageInvalid);
                     }
                 }
             }
         }
-        if Some(count) != self.head.counters.particles.checked_add(c.emitted).and_then(|n| n.checked_sub(c.exited)) {
+        if Some(count) != self.head.counters.particles.checked_add(c.emitted).and_then(|n| n.checked_sub(c.exited)).and_then(|n| n.checked_sub(c.expired)) {
             return Err(Error::ImageInvalid);
         }
         let (_, p) = self.planes::<u8>();
@@ -241,6 +247,9 @@ impl World {
         }
         p.occupancy.copy_from_slice(occupancy);
         p.velocity.copy_from_slice(velocity);
+        for (to, from) in p.life.iter_mut().zip(life.chunks_exact(2)) {
+            *to = u16::from_ne_bytes([from[0], from[1]]);
+        }
         // The step's summaries of empty rows and words (M3): "may hold a
         // particle" everywhere, so that the next step sweeps what came in.
         p.rows.fill(1);
@@ -260,6 +269,7 @@ impl World {
         let h = &mut self.head.counters;
         h.add_step(&Counters {
             exited: c.exited,
+            expired: c.expired,
             collisions: c.collisions,
             clamps: c.clamps,
             clamp_energy: c.clamp_energy,
@@ -268,7 +278,7 @@ impl World {
         });
         h.emitted = h.emitted.saturating_add(c.emitted);
         h.shortfall = h.shortfall.saturating_add(c.shortfall);
-        h.particles = h.particles.saturating_add(c.emitted).saturating_sub(c.exited);
+        h.particles = h.particles.saturating_add(c.emitted).saturating_sub(c.exited).saturating_sub(c.expired);
         h.processed = c.blocks_processed;
         h.skipped = total.saturating_sub(c.blocks_processed);
         self.head.step = self.head.step.wrapping_add(c.steps);
