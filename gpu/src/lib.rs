@@ -44,7 +44,7 @@
 mod export;
 
 pub use export::Exports;
-use mpca::port::{PortPlanes, StepConstants, StepCounts, VortexConstants};
+use mpca::port::{DragConstants, PortPlanes, StepConstants, StepCounts, VortexConstants};
 use mpca::{Boundary, Collisions, Description, Drift, Identity, Method, Quantization, World, WorldBox};
 use wgpu::util::DeviceExt;
 
@@ -131,12 +131,10 @@ impl Gpu {
 
 /// Why this backend cannot run a description: `None` where it can.
 pub fn unsupported(d: &Description) -> Option<&'static str> {
-    let checks: [(bool, &'static str); 8] = [
+    let checks: [(bool, &'static str); 6] = [
         (d.dim == 2, "3D worlds"),
         (!d.per_particle_mass, "per-particle masses"),
         (!d.obstacles, "obstacles"),
-        (!(d.forces.field || d.forces.potential), "force fields and potentials"),
-        (d.drag.rate == 0.0, "flow drag"),
         (d.method == Method::ExactFast, "an assignment other than exact-fast"),
         (!d.energy_neutral, "energy-neutral rounding"),
         (d.identity == Identity::NONE, "ids, ages and tags"),
@@ -213,6 +211,9 @@ pub struct GpuWorld {
     velocity: [wgpu::Buffer; 2],
     /// The lifetimes (M6), where the world has them (a word otherwise).
     life: [wgpu::Buffer; 2],
+    /// The force field, potential and wind planes (M5.1, M5.1b), as the
+    /// world had them when made or loaded.
+    fields: [wgpu::Buffer; 3],
     counters: wgpu::Buffer,
     /// `groups[i]` reads pair member `i` and writes the other.
     groups: [wgpu::BindGroup; 2],
@@ -244,6 +245,8 @@ impl GpuWorld {
         let occupancy = [buffer("occupancy 0", &occupancy), buffer("occupancy 1", &occupancy)];
         let velocity = [buffer("velocity 0", &velocity), buffer("velocity 1", &velocity)];
         let life = [buffer("life 0", &life), buffer("life 1", &life)];
+        let f = host.port_fields();
+        let fields = [buffer("force field", f.force), buffer("potential", f.potential), buffer("wind", f.wind)];
         let counters = buffer("counters", bytemuck::cast_slice(&counters_of(&host)));
         let params = buffer("params", bytemuck::cast_slice(&params(&host.port_constants(), &desc, emitter_count(&host) as u32)));
         let tables = buffer("tables", bytemuck::cast_slice(&tables(mpca::port::move_table_8(desc.drift))));
@@ -282,7 +285,7 @@ impl GpuWorld {
         let layout = pipeline.get_bind_group_layout(0);
         let group = |from: usize| {
             let to = 1 - from;
-            let entries = [(0, &params), (1, &tables), (2, &occupancy[from]), (3, &velocity[from]), (4, &occupancy[to]), (5, &velocity[to]), (6, &counters), (11, &life[from]), (12, &life[to])];
+            let entries = [(0, &params), (1, &tables), (2, &occupancy[from]), (3, &velocity[from]), (4, &occupancy[to]), (5, &velocity[to]), (6, &counters), (11, &life[from]), (12, &life[to]), (14, &fields[0]), (15, &fields[1]), (16, &fields[2])];
             let entries: Vec<wgpu::BindGroupEntry<'_>> = entries.iter().map(|&(binding, b)| wgpu::BindGroupEntry { binding, resource: b.as_entire_binding() }).collect();
             device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("step"), layout: &layout, entries: &entries })
         };
@@ -303,6 +306,7 @@ impl GpuWorld {
             occupancy,
             velocity,
             life,
+            fields,
             counters,
             groups,
             current: 0,
@@ -335,6 +339,10 @@ impl GpuWorld {
         queue.write_buffer(&self.occupancy[self.current], 0, bytemuck::cast_slice(p.occupancy));
         queue.write_buffer(&self.velocity[self.current], 0, &padded(p.velocity));
         queue.write_buffer(&self.life[self.current], 0, &padded(p.life));
+        let f = host.port_fields();
+        for (buffer, plane) in self.fields.iter().zip([f.force, f.potential, f.wind]) {
+            queue.write_buffer(buffer, 0, &padded(plane));
+        }
         queue.write_buffer(&self.counters, 0, bytemuck::cast_slice(&counters_of(&host)));
         queue.write_buffer(&self.params, 0, bytemuck::cast_slice(&params(&host.port_constants(), &desc, emitter_count(&host) as u32)));
         queue.write_buffer(&self.tables, 0, bytemuck::cast_slice(&tables(mpca::port::move_table_8(desc.drift))));
@@ -461,7 +469,7 @@ fn counters_of(host: &World) -> [u32; COUNTERS] {
 }
 
 /// The shader's parameters (`step2d.wgsl`).
-const PARAMS: usize = 37;
+const PARAMS: usize = 50;
 
 /// A face as the shader reads it: 0 periodic, 1 wall, 2 open.
 fn face(b: Boundary) -> u32 {
@@ -480,7 +488,10 @@ fn params(c: &StepConstants, d: &Description, d_emitters: u32) -> [u32; PARAMS] 
     let (nx, ny) = (d.size[0], d.size[1]);
     let faces = face(d.boundary[0][0]) | face(d.boundary[0][1]) << 2 | face(d.boundary[1][0]) << 4 | face(d.boundary[1][1]) << 6;
     let g = c.push.map(|g| g as u64);
-    let v = c.vortex.unwrap_or(VortexConstants { centre: [0; 2], core: 0, g: 0, e: 0 });
+    let v = c.vortex.unwrap_or(VortexConstants { centre: [0; 2], core: 0, force: None, flow: None });
+    let (force, flow) = (v.force.unwrap_or_default(), v.flow.unwrap_or_default());
+    let drag = c.drag.unwrap_or(DragConstants { keep: 0, wind: [0; 3], field: false });
+    let on = |x: bool| u32::from(x);
     [
         lo(d.seed),
         hi(d.seed),
@@ -504,20 +515,33 @@ fn params(c: &StepConstants, d: &Description, d_emitters: u32) -> [u32; PARAMS] 
         hi(g[1]),
         lo(g[2]),
         hi(g[2]),
-        u32::from(c.push != [0; 3] || c.vortex.is_some()),
+        on(c.push != [0; 3] || v.force.is_some() || d.forces.field || d.forces.potential),
         u32::from(d.drift == Drift::Calibrated),
         u32::from(d.collisions == Collisions::SpeedLimited),
         c.speed_limit as u32,
         u32::from(d.contacts),
-        u32::from(c.vortex.is_some()),
+        on(v.force.is_some()),
         lo(v.centre[0] as u64),
         hi(v.centre[0] as u64),
         lo(v.centre[1] as u64),
         hi(v.centre[1] as u64),
         v.core,
-        v.g as u32,
-        v.e as u32,
+        force.0 as u32,
+        force.1 as u32,
         d_emitters,
-        u32::from(d.lifetimes),
+        on(d.lifetimes),
+        c.class_push,
+        on(d.forces.potential),
+        on(d.forces.field),
+        0,
+        flow.0 as u32,
+        flow.1 as u32,
+        on(c.drag.is_some()),
+        drag.keep as u32,
+        drag.wind[0] as u32,
+        drag.wind[1] as u32,
+        on(drag.field),
+        on(v.flow.is_some()),
+        (c.unit >> c.fine) as u32,
     ]
 }

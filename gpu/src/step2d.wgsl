@@ -20,7 +20,11 @@
 // collisions (M5.2b), 25 their limit L (fine units), 26 contacts (M5.7),
 // 27 the vortex force (M5.1), 28-31 its centre (x, y as 64-bit pairs,
 // 2^-8 cells), 32 its core (2^-8 cells), 33-34 its strength top(Γ') (g,
-// e), 35 the emitters, 36 lifetimes.
+// e), 35 the emitters, 36 lifetimes, 37 K = dt / m (f32 bits), 38 the
+// potential, 39 the force field, 41-42 the vortex's strength as a flow
+// top(Γ'') (g, e), 43 drag (M5.1b), 44 its weight C (Q16), 45-46 the
+// uniform wind U (fine units), 47 the flow holds the wind plane, 48 the
+// flow holds the vortex, 49 S (quanta to a unit speed).
 @group(0) @binding(0) var<storage, read> params: array<u32>;
 // tables: 0..256 M5.3 move limits; 256..2304 the turns of M5.2 (cos, sin
 // as i32); 2304..3600 per 2D key its assignments (start | count << 16,
@@ -52,6 +56,12 @@
 @group(0) @binding(11) var<storage, read> life_in: array<u32>;
 @group(0) @binding(12) var<storage, read_write> life_out: array<u32>;
 @group(0) @binding(13) var<storage, read_write> life_emit: array<u32>;
+// The f32 settings per cell, as their bits (a word where the world has
+// none): M5.1's force field (two a cell) and potential, M5.1b's wind plane
+// (two a cell).
+@group(0) @binding(14) var<storage, read> field: array<u32>;
+@group(0) @binding(15) var<storage, read> potential: array<u32>;
+@group(0) @binding(16) var<storage, read> wind: array<u32>;
 
 const TURNS_AT: u32 = 256u;
 const KEYS_AT: u32 = 2304u;
@@ -410,11 +420,11 @@ fn clamp64(a: vec2<u32>, bound: i32) -> i32 {
     return select(bound, min(bitcast<i32>(a.x), bound), fits);
 }
 
-// M5.1's Rankine vortex at cell (x, y) as a push (M1c): the 16-bit
-// strength (params[33], exponent params[34]) over max(|d|^2, R'^2), with
-// the offsets and the core (params[28..33]) cut to 15 bits, one 32-bit
+// M5.1's Rankine vortex at cell (x, y) as a push (M1c), or M5.1b's as a
+// flow: the 16-bit strength (g, exponent e) over max(|d|^2, R'^2), with the
+// offsets and the core (params[28..33]) cut to 15 bits, one 32-bit
 // division, the last shift saturated at 2^59. Two 64-bit components.
-fn swirl(x: u32, y: u32) -> array<vec2<u32>, 2> {
+fn swirl(x: u32, y: u32, g: i32, exponent: i32) -> array<vec2<u32>, 2> {
     let reach = 1 << 28u;
     let at = array<u32, 2>(x, y);
     var d: array<i32, 2>;
@@ -423,7 +433,6 @@ fn swirl(x: u32, y: u32) -> array<vec2<u32>, 2> {
         d[k] = clamp64(sub64(cell, vec2<u32>(params[28u + 2u * k], params[29u + 2u * k])), reach);
     }
     var zero: array<vec2<u32>, 2>;
-    let g = bitcast<i32>(params[33]);
     let core = params[32];
     var ax = u32(abs(d[0]));
     var ay = u32(abs(d[1]));
@@ -439,7 +448,7 @@ fn swirl(x: u32, y: u32) -> array<vec2<u32>, 2> {
     let b = 32u - countLeadingZeros(n);
     let top = select(n << (16u - b), n >> (b - 16u), b > 16u);
     let f = (u32(abs(g)) << 15u) / top;
-    let e = bitcast<i32>(params[34]) - i32(cut) - i32(b) + 1;
+    let e = exponent - i32(cut) - i32(b) + 1;
     var out: array<vec2<u32>, 2>;
     let parts = array<u32, 2>(ay, ax);
     let negative = array<bool, 2>(d[1] > 0, d[0] < 0);
@@ -484,19 +493,118 @@ fn pushed(x: vec2<i32>, dv: array<vec2<u32>, 3>) -> vec2<i32> {
     return out;
 }
 
-// M5.1's push on the particle in cell (x, y): G (params[16..22]) and the
-// vortex where it is on (params[27]).
+// M1c's conv: the exact product a b c 2^shift of two f32 (their bits)
+// and a whole c below 2^15, rounded to nearest (halves away from zero) and
+// saturated to +-2^59, 64-bit two's complement; NaN gives 0.
+fn conv(a: u32, b: u32, c: u32, shift: i32) -> vec2<u32> {
+    if (a & 0x7fffffffu) > 0x7f800000u || (b & 0x7fffffffu) > 0x7f800000u {
+        return vec2<u32>(0u, 0u);
+    }
+    // |x| = m 2^e, m below 2^24.
+    let ea = i32(a >> 23u & 0xffu);
+    let eb = i32(b >> 23u & 0xffu);
+    let ma = select((a & 0x7fffffu) | 0x800000u, a & 0x7fffffu, ea == 0);
+    let mb = select((b & 0x7fffffu) | 0x800000u, b & 0x7fffffu, eb == 0);
+    let e = select(ea - 150, -149, ea == 0) + select(eb - 150, -149, eb == 0) + shift;
+    let p = mul64(mul32(ma, mb), vec2<u32>(c, 0u));
+    let most = vec2<u32>(0u, 1u << 27u);
+    var m = vec2<u32>(0u, 0u);
+    if is_zero64(p) {
+        m = p;
+    } else if e >= 0 {
+        if e >= 59 || lt64(shr64(most, u32(e)), p) {
+            m = most;
+        } else {
+            m = shl64(p, u32(e));
+        }
+    } else if e >= -63 {
+        m = shr64(add64(shr64(p, u32(-e - 1)), vec2<u32>(1u, 0u)), 1u);
+    }
+    if lt64(most, m) {
+        m = most;
+    }
+    return select(m, neg64(m), (a >> 31u) != (b >> 31u));
+}
+
+// M1c's U of a speed (f32 bits) in fine units: conv(u, W, 0), saturated to
+// +-2^30.
+fn to_fine(u: u32) -> i32 {
+    return clamp64(conv(u, 0x3f800000u, params[49], i32(fine())), 1 << 30u);
+}
+
+// The potential at cell i as a push: conv(U, K S, F).
+fn potential_at(i: u32) -> vec2<u32> {
+    return conv(potential[i], params[37], params[49], i32(fine()));
+}
+
+// M5.1's push on the particle in cell (x, y): G (params[16..22]), the
+// force field's conv(f, K S, F), -grad U by central differences of the
+// converted potential (one-sided at a face that is not periodic), and the
+// vortex's push, where each is on; 64 bits a component.
 fn push_at(x: u32, y: u32) -> array<vec2<u32>, 3> {
+    let nx = params[6];
+    let ny = params[7];
+    let cell = y * nx + x;
     var dv: array<vec2<u32>, 3>;
     for (var k = 0u; k < 3u; k++) {
         dv[k] = vec2<u32>(params[16u + 2u * k], params[17u + 2u * k]);
     }
+    if params[39] != 0u {
+        for (var k = 0u; k < 2u; k++) {
+            dv[k] = add64(dv[k], conv(field[2u * cell + k], params[37], params[49], i32(fine())));
+        }
+    }
+    if params[38] != 0u {
+        let at = array<u32, 2>(x, y);
+        let n = array<u32, 2>(nx, ny);
+        let stride = array<u32, 2>(1u, nx);
+        for (var k = 0u; k < 2u; k++) {
+            let periodic = face(k, false) == 0u;
+            let lo_in = at[k] > 0u || periodic;
+            let hi_in = at[k] + 1u < n[k] || periodic;
+            let lo = select(cell + (n[k] - 1u) * stride[k], cell - stride[k], at[k] > 0u);
+            let hi = select(cell - (n[k] - 1u) * stride[k], cell + stride[k], at[k] + 1u < n[k]);
+            var g = vec2<u32>(0u, 0u);
+            if lo_in && hi_in {
+                // An arithmetic shift by one of the 64-bit difference.
+                let d = sub64(potential_at(lo), potential_at(hi));
+                g = vec2<u32>((d.x >> 1u) | (d.y << 31u), bitcast<u32>(bitcast<i32>(d.y) >> 1u));
+            } else if hi_in {
+                g = sub64(potential_at(cell), potential_at(hi));
+            } else if lo_in {
+                g = sub64(potential_at(lo), potential_at(cell));
+            }
+            dv[k] = add64(dv[k], g);
+        }
+    }
     if params[27] != 0u {
-        let t = swirl(x, y);
+        let t = swirl(x, y, bitcast<i32>(params[33]), bitcast<i32>(params[34]));
         dv[0] = add64(dv[0], t[0]);
         dv[1] = add64(dv[1], t[1]);
     }
     return dv;
+}
+
+// M5.1b's flow at cell (x, y) in fine units: the uniform wind, the wind
+// plane's value and the vortex read as a velocity, where each is on, each
+// component saturated to +-2^30.
+fn flow_at(x: u32, y: u32) -> vec2<i32> {
+    let cell = y * params[6] + x;
+    var u: array<vec2<u32>, 2>;
+    for (var k = 0u; k < 2u; k++) {
+        let uk = bitcast<i32>(params[45u + k]);
+        u[k] = vec2<u32>(bitcast<u32>(uk), select(0u, 0xffffffffu, uk < 0));
+        if params[47] != 0u {
+            let w = to_fine(wind[2u * cell + k]);
+            u[k] = add64(u[k], vec2<u32>(bitcast<u32>(w), select(0u, 0xffffffffu, w < 0)));
+        }
+    }
+    if params[48] != 0u {
+        let t = swirl(x, y, bitcast<i32>(params[41]), bitcast<i32>(params[42]));
+        u[0] = add64(u[0], t[0]);
+        u[1] = add64(u[1], t[1]);
+    }
+    return vec2<i32>(clamp64(u[0], 1 << 30u), clamp64(u[1], 1 << 30u));
 }
 
 // Eqs. 7-8 for the pair (a, c) with working velocities xa, xc and
@@ -567,6 +675,25 @@ fn change(b: ptr<function, Block>, at: array<vec2<u32>, 4>, s: ptr<function, Str
                 x[c] = clamp_speed(pushed(x[c], dv), counts);
                 changed |= 1u << c;
             }
+        }
+    }
+    // M5.1b: towards the flow, C v + (1 - C) u.
+    if params[43] != 0u {
+        let keep = bitcast<i32>(params[44]);
+        for (var c = 0u; c < 4u; c++) {
+            if ((*b).occ >> c & 1u) == 0u {
+                continue;
+            }
+            let u = flow_at(at[c].x, at[c].y);
+            var y: vec2<i32>;
+            for (var k = 0; k < 2; k++) {
+                let a = mulq(x[c][k], keep, 16u);
+                let w = mulq(u[k], 65536 - keep, 16u);
+                let sum = add64(vec2<u32>(bitcast<u32>(a), select(0u, 0xffffffffu, a < 0)), vec2<u32>(bitcast<u32>(w), select(0u, 0xffffffffu, w < 0)));
+                y[k] = clamp64(sum, 1 << 30u);
+            }
+            x[c] = clamp_speed(y, counts);
+            changed |= 1u << c;
         }
     }
     // M5.2's pair, the block's first draw.

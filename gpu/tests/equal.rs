@@ -394,3 +394,42 @@ fn emitters_and_the_vortex_step_as_on_the_cpu() {
         }
     }
 }
+
+#[test]
+fn the_smoke_scene_with_flow_drag_steps_as_on_the_cpu() {
+    // 4.3b: buoyancy, drag towards a vortex fed through its core (the wind
+    // plane and the vortex read as a flow), speed-limited collisions, an
+    // emitter; 1,200 steps, compared every 100.
+    same_scene(mpca_tests::scenes::smoke_flow(), 100);
+}
+
+#[test]
+fn force_fields_potentials_and_drag_step_as_on_the_cpu() {
+    // Every per-cell term at once, from random planes (some values large
+    // enough to saturate M1c's conv, some tiny): a force field, a
+    // potential (one-sided at the walls, wrapped on the periodic axis),
+    // drag towards a uniform wind plus the wind plane plus the vortex as a
+    // flow, and the vortex force; at both widths, periodic x and walled y.
+    for quantization in [mpca::Quantization::Bits8, mpca::Quantization::Bits16] {
+        let mut w = gas(34, 20, 0.4, 81, |d| {
+            d.quantization = quantization;
+            d.boundary[1] = [mpca::Boundary::Wall; 2];
+            d.forces.field = true;
+            d.forces.potential = true;
+            d.forces.vortex = true;
+            d.vortex = mpca::Vortex { centre: [17.0, 10.5], core_radius: 4.0, circulation: 3.0 };
+            d.drag = mpca::Drag { rate: 0.2, wind: [0.1, -0.05, 0.0], field: true, vortex: true };
+            d.mass = 1.7;
+        });
+        let mut rng = mpca::rng::block_stream(82, 0, 0);
+        let cells = 34 * 20;
+        let mut value = |scale: f32| (rng.bits(16) as f32 / 32768.0 - 1.0) * scale;
+        let force: Vec<f32> = (0..2 * cells).map(|i| value(if i % 97 == 0 { 1e30 } else if i % 89 == 0 { 1e-20 } else { 0.02 })).collect();
+        let potential: Vec<f32> = (0..cells).map(|_| value(0.05)).collect();
+        let wind: Vec<f32> = (0..cells).flat_map(|_| [value(0.3), value(0.3)]).collect();
+        w.set_force_field(&force).unwrap();
+        w.set_potential(&potential).unwrap();
+        w.set_wind_field(&wind).unwrap();
+        same_worlds(&mut w, 25, 1);
+    }
+}

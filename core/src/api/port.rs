@@ -9,7 +9,7 @@
 
 use crate::api::desc::Drift;
 use crate::rules::emitter::{split_rate, EmitterStats};
-use crate::rules::fixed::{csqrt, magnitude, parts, scaled, scaled_by, to_fine, unit_scale};
+use crate::rules::fixed::{csqrt, divr, magnitude, parts, scaled, scaled_by, to_fine, unit_scale};
 use crate::rules::force::Swirl;
 use crate::rules::quant::Quant;
 use crate::rules::rng::StepKey;
@@ -51,23 +51,42 @@ pub struct StepConstants {
     /// M5.3: per stored 8-bit component (as a byte), the largest 16
     /// random bits that say "move".
     pub moves: &'static [u16; 256],
-    /// M5.1's Rankine vortex force, where it is on (M1c).
+    /// M5.1's Rankine vortex, where the force or the flow of M5.1b reads
+    /// it (M1c).
     pub vortex: Option<VortexConstants>,
+    /// M1c's `K = quot(dt, m)` for the world's mass, as the bits of its
+    /// `f32`: the field's and the potential's pushes are `conv(f, K S, F)`.
+    pub class_push: u32,
+    /// M5.1b's drag, where its rate is not 0.
+    pub drag: Option<DragConstants>,
 }
 
 /// M5.1's vortex as the step reads it (M1c): its centre and core radius
-/// in `2^-8` cells, and its strength for the world's mass as `top(Γ')`, a
-/// 16-bit significand `g` (signed) and an exponent `e`.
+/// in `2^-8` cells, and its strengths as `top(Γ)`, each a 16-bit
+/// significand `g` (signed) and an exponent `e`: as a force for the
+/// world's mass (`Γ'`) where the force is on, and as a flow (`Γ''`) where
+/// the drag reads it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct VortexConstants {
     /// See the type.
     pub centre: [i64; 2],
     /// See the type.
     pub core: u32,
-    /// See the type.
-    pub g: i32,
-    /// See the type.
-    pub e: i32,
+    /// `(g, e)` of `Γ'`, where the force is on.
+    pub force: Option<(i32, i32)>,
+    /// `(g, e)` of `Γ''`, where the drag's flow holds the vortex.
+    pub flow: Option<(i32, i32)>,
+}
+
+/// M5.1b's drag as the step reads it (M1c).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct DragConstants {
+    /// `C = 2^16 / (1 + dt rate)`, rounded: the weight of the velocity.
+    pub keep: i32,
+    /// The uniform wind `U` in fine units.
+    pub wind: [i32; 3],
+    /// The flow adds the wind plane.
+    pub field: bool,
 }
 
 /// An emitter as a step reads it (M6, M1c).
@@ -131,6 +150,19 @@ pub struct PortPlanes<'a> {
     pub life: &'a [u8],
 }
 
+/// A world's planes of `f32` settings per cell (M5.1, M5.1b), as their
+/// bytes: `dim` values a cell for the force field and the wind, one for
+/// the potential; each empty where the world has none. A step reads them
+/// and writes none.
+pub struct PortFields<'a> {
+    /// M5.1's force field.
+    pub force: &'a [u8],
+    /// M5.1's potential.
+    pub potential: &'a [u8],
+    /// M5.1b's wind plane.
+    pub wind: &'a [u8],
+}
+
 impl World {
     /// The integers of the step this world takes next (M1c, M8).
     pub fn port_constants(&self) -> StepConstants {
@@ -154,11 +186,24 @@ impl World {
             fine,
             energy: (m as u32, e),
             moves: crate::rules::quant::move_table_8(desc.drift),
-            vortex: (cfg!(feature = "vortex") && desc.forces.vortex).then(|| {
-                let swirl = Swirl::of(&desc.vortex);
-                let (centre, core) = swirl.integers();
-                let strength = swirl.gamma(class.push, (s as u32, fine as i32));
-                VortexConstants { centre, core, g: strength.g, e: strength.e }
+            vortex: {
+                let force = cfg!(feature = "vortex") && desc.forces.vortex;
+                let flow = desc.has_drag() && desc.drag.vortex;
+                (force || flow).then(|| {
+                    let swirl = Swirl::of(&desc.vortex);
+                    let (centre, core) = swirl.integers();
+                    let top = |k: f32| {
+                        let t = swirl.gamma(k, (s as u32, fine as i32));
+                        (t.g, t.e)
+                    };
+                    VortexConstants { centre, core, force: force.then(|| top(class.push)), flow: flow.then(|| top(1.0)) }
+                })
+            },
+            class_push: class.push.to_bits(),
+            drag: desc.has_drag().then(|| DragConstants {
+                keep: divr(1 << 48, (1 << 32) + scaled(desc.dt, desc.drag.rate, 32) as u64) as i32,
+                wind: desc.drag.wind.map(|u| to_fine(u, (s as u32, fine as i32))),
+                field: desc.drag.field,
             }),
         }
     }
@@ -183,6 +228,12 @@ impl World {
     pub fn port_planes(&self) -> PortPlanes<'_> {
         let l = self.layout();
         PortPlanes { occupancy: self.plane(l.occupancy()), row_words: l.row_words, velocity: self.plane_bytes(l.velocity()), life: self.plane_bytes(l.life()) }
+    }
+
+    /// The force field, potential and wind planes (M5.1, M5.1b).
+    pub fn port_fields(&self) -> PortFields<'_> {
+        let l = self.layout();
+        PortFields { force: self.plane_bytes(l.field()), potential: self.plane_bytes(l.potential()), wind: self.plane_bytes(l.wind()) }
     }
 
     /// Takes the world `c.steps` steps that ran elsewhere left: its
