@@ -12,14 +12,14 @@
 //! come the hash, the statistics and the snapshot image.
 //!
 //! This version runs the 2D rule with 8-bit or 16-bit velocities and one
-//! mass on any faces: the uniform force and the vortex (M5.1), collisions
-//! (M5.2 and M5.2b, any restitution), both drift rules (M5.3), reflection
-//! off walls (M5.4), the exact-fast assignment (M5.6), contacts (M5.7),
-//! exits through open faces, emitters and lifetimes (M6): the paper's
-//! aggregation, cluster and smoke scenes and the benchmark's gas. A
-//! description that needs any other part is refused when the world is made,
-//! as a CPU build without that part refuses it
-//! ([`mpca::Error::FeatureDisabled`]).
+//! mass on any faces: every force term (M5.1) and flow drag (M5.1b),
+//! collisions (M5.2 and M5.2b, any restitution), both drift rules (M5.3),
+//! reflection off walls (M5.4), the exact-fast assignment (M5.6), contacts
+//! (M5.7), exits through open faces, emitters and lifetimes (M6): the
+//! paper's aggregation, cluster and smoke scenes, the smoke with flow drag
+//! and the benchmark's gas. A description that needs any other part is
+//! refused when the world is made, as a CPU build without that part refuses
+//! it ([`mpca::Error::FeatureDisabled`]).
 //!
 //! ```
 //! use mpca::{Description, WorldBox};
