@@ -14,12 +14,12 @@
 //! This version runs the 2D rule with 8-bit or 16-bit velocities and one
 //! mass on any faces: every force term (M5.1) and flow drag (M5.1b),
 //! collisions (M5.2 and M5.2b, any restitution), both drift rules (M5.3),
-//! reflection off walls (M5.4), the exact-fast assignment (M5.6), contacts
-//! (M5.7), exits through open faces, emitters and lifetimes (M6): the
-//! paper's aggregation, cluster and smoke scenes, the smoke with flow drag
-//! and the benchmark's gas. A description that needs any other part is
-//! refused when the world is made, as a CPU build without that part refuses
-//! it ([`mpca::Error::FeatureDisabled`]).
+//! reflection off walls and obstacles (M5.4, M7), the exact-fast assignment
+//! (M5.6), contacts (M5.7), exits through open faces, emitters and
+//! lifetimes (M6): the paper's aggregation, cluster and smoke scenes, the
+//! smoke with flow drag and the benchmark's gas. A description that needs
+//! any other part is refused when the world is made, as a CPU build without
+//! that part refuses it ([`mpca::Error::FeatureDisabled`]).
 //!
 //! ```
 //! use mpca::{Description, WorldBox};
@@ -131,10 +131,9 @@ impl Gpu {
 
 /// Why this backend cannot run a description: `None` where it can.
 pub fn unsupported(d: &Description) -> Option<&'static str> {
-    let checks: [(bool, &'static str); 6] = [
+    let checks: [(bool, &'static str); 5] = [
         (d.dim == 2, "3D worlds"),
         (!d.per_particle_mass, "per-particle masses"),
-        (!d.obstacles, "obstacles"),
         (d.method == Method::ExactFast, "an assignment other than exact-fast"),
         (!d.energy_neutral, "energy-neutral rounding"),
         (d.identity == Identity::NONE, "ids, ages and tags"),
@@ -214,6 +213,9 @@ pub struct GpuWorld {
     /// The force field, potential and wind planes (M5.1, M5.1b), as the
     /// world had them when made or loaded.
     fields: [wgpu::Buffer; 3],
+    /// The obstacle cells and their surface entries (M7), as the world had
+    /// them when made or loaded.
+    obstacles: [wgpu::Buffer; 2],
     counters: wgpu::Buffer,
     /// `groups[i]` reads pair member `i` and writes the other.
     groups: [wgpu::BindGroup; 2],
@@ -247,8 +249,11 @@ impl GpuWorld {
         let life = [buffer("life 0", &life), buffer("life 1", &life)];
         let f = host.port_fields();
         let fields = [buffer("force field", f.force), buffer("potential", f.potential), buffer("wind", f.wind)];
+        // Room for every surface entry the world can hold: an image may
+        // bring more.
+        let obstacles = [buffer("obstacles", bytemuck::cast_slice(host.port_obstacles())), buffer("surfaces", &surface_bytes(&host))];
         let counters = buffer("counters", bytemuck::cast_slice(&counters_of(&host)));
-        let params = buffer("params", bytemuck::cast_slice(&params(&host.port_constants(), &desc, emitter_count(&host) as u32)));
+        let params = buffer("params", bytemuck::cast_slice(&params(&host.port_constants(), &desc, emitter_count(&host) as u32, surface_table(&host).len() as u32 / 4)));
         let tables = buffer("tables", bytemuck::cast_slice(&tables(mpca::port::move_table_8(desc.drift))));
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some("step2d.wgsl"), source: wgpu::ShaderSource::Wgsl(include_str!("step2d.wgsl").into()) });
         let pipeline_of = |entry: &str| {
@@ -271,7 +276,7 @@ impl GpuWorld {
             let pipeline = pipeline_of("emit");
             let layout = pipeline.get_bind_group_layout(0);
             let group = |member: usize| {
-                let entries = [(0, &params), (6, &counters), (7, &occupancy[member]), (8, &velocity[member]), (9, &emitters), (10, &emitter_stats), (13, &life[member])];
+                let entries = [(0, &params), (6, &counters), (7, &occupancy[member]), (8, &velocity[member]), (9, &emitters), (10, &emitter_stats), (13, &life[member]), (17, &obstacles[0])];
                 let entries: Vec<wgpu::BindGroupEntry<'_>> = entries.iter().map(|&(binding, b)| wgpu::BindGroupEntry { binding, resource: b.as_entire_binding() }).collect();
                 device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("emit"), layout: &layout, entries: &entries })
             };
@@ -285,7 +290,7 @@ impl GpuWorld {
         let layout = pipeline.get_bind_group_layout(0);
         let group = |from: usize| {
             let to = 1 - from;
-            let entries = [(0, &params), (1, &tables), (2, &occupancy[from]), (3, &velocity[from]), (4, &occupancy[to]), (5, &velocity[to]), (6, &counters), (11, &life[from]), (12, &life[to]), (14, &fields[0]), (15, &fields[1]), (16, &fields[2])];
+            let entries = [(0, &params), (1, &tables), (2, &occupancy[from]), (3, &velocity[from]), (4, &occupancy[to]), (5, &velocity[to]), (6, &counters), (11, &life[from]), (12, &life[to]), (14, &fields[0]), (15, &fields[1]), (16, &fields[2]), (17, &obstacles[0]), (18, &obstacles[1])];
             let entries: Vec<wgpu::BindGroupEntry<'_>> = entries.iter().map(|&(binding, b)| wgpu::BindGroupEntry { binding, resource: b.as_entire_binding() }).collect();
             device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("step"), layout: &layout, entries: &entries })
         };
@@ -307,6 +312,7 @@ impl GpuWorld {
             velocity,
             life,
             fields,
+            obstacles,
             counters,
             groups,
             current: 0,
@@ -343,8 +349,10 @@ impl GpuWorld {
         for (buffer, plane) in self.fields.iter().zip([f.force, f.potential, f.wind]) {
             queue.write_buffer(buffer, 0, &padded(plane));
         }
+        queue.write_buffer(&self.obstacles[0], 0, &padded(bytemuck::cast_slice(host.port_obstacles())));
+        queue.write_buffer(&self.obstacles[1], 0, &surface_bytes(&host));
         queue.write_buffer(&self.counters, 0, bytemuck::cast_slice(&counters_of(&host)));
-        queue.write_buffer(&self.params, 0, bytemuck::cast_slice(&params(&host.port_constants(), &desc, emitter_count(&host) as u32)));
+        queue.write_buffer(&self.params, 0, bytemuck::cast_slice(&params(&host.port_constants(), &desc, emitter_count(&host) as u32, surface_table(&host).len() as u32 / 4)));
         queue.write_buffer(&self.tables, 0, bytemuck::cast_slice(&tables(mpca::port::move_table_8(desc.drift))));
         let capacity = self.emitter_stats.size() as usize / 16;
         queue.write_buffer(&self.emitters, 0, &padded(bytemuck::cast_slice(&emitter_table(&host, capacity))));
@@ -443,6 +451,20 @@ fn padded(bytes: &[u8]) -> Vec<u8> {
     contents
 }
 
+/// The surface entries of `host`'s obstacles as the shader reads them
+/// (`step2d.wgsl`): cell, normal x and y in Q30, restitution in Q16.
+fn surface_table(host: &World) -> Vec<u32> {
+    (0..).map_while(|i| host.port_surface(i)).flat_map(|e| [e.cell, e.normal[0] as u32, e.normal[1] as u32, e.restitution as u32]).collect()
+}
+
+/// [`surface_table`] as bytes, with room for every entry the world's
+/// description allows.
+fn surface_bytes(host: &World) -> Vec<u8> {
+    let mut table = surface_table(host);
+    table.resize(4 * (host.description().surface_capacity as usize).max(1), 0);
+    bytemuck::cast_slice(&table).to_vec()
+}
+
 /// The emitters `host` has.
 fn emitter_count(host: &World) -> usize {
     (0..).take_while(|&i| host.port_emitter(i).is_some()).count()
@@ -469,7 +491,7 @@ fn counters_of(host: &World) -> [u32; COUNTERS] {
 }
 
 /// The shader's parameters (`step2d.wgsl`).
-const PARAMS: usize = 50;
+const PARAMS: usize = 51;
 
 /// A face as the shader reads it: 0 periodic, 1 wall, 2 open.
 fn face(b: Boundary) -> u32 {
@@ -482,7 +504,7 @@ fn face(b: Boundary) -> u32 {
 
 /// The shader's parameters, the same every step (`step2d.wgsl`), from
 /// the constants of any step `c`.
-fn params(c: &StepConstants, d: &Description, d_emitters: u32) -> [u32; PARAMS] {
+fn params(c: &StepConstants, d: &Description, d_emitters: u32, surfaces: u32) -> [u32; PARAMS] {
     let lo = |x: u64| x as u32;
     let hi = |x: u64| (x >> 32) as u32;
     let (nx, ny) = (d.size[0], d.size[1]);
@@ -533,7 +555,7 @@ fn params(c: &StepConstants, d: &Description, d_emitters: u32) -> [u32; PARAMS] 
         c.class_push,
         on(d.forces.potential),
         on(d.forces.field),
-        0,
+        surfaces,
         flow.0 as u32,
         flow.1 as u32,
         on(c.drag.is_some()),
@@ -543,5 +565,6 @@ fn params(c: &StepConstants, d: &Description, d_emitters: u32) -> [u32; PARAMS] 
         on(drag.field),
         on(v.flow.is_some()),
         (c.unit >> c.fine) as u32,
+        on(d.obstacles),
     ]
 }

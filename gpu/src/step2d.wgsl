@@ -24,7 +24,8 @@
 // potential, 39 the force field, 41-42 the vortex's strength as a flow
 // top(Γ'') (g, e), 43 drag (M5.1b), 44 its weight C (Q16), 45-46 the
 // uniform wind U (fine units), 47 the flow holds the wind plane, 48 the
-// flow holds the vortex, 49 S (quanta to a unit speed).
+// flow holds the vortex, 49 S (quanta to a unit speed), 40 the surface
+// entries, 50 obstacles.
 @group(0) @binding(0) var<storage, read> params: array<u32>;
 // tables: 0..256 M5.3 move limits; 256..2304 the turns of M5.2 (cos, sin
 // as i32); 2304..3600 per 2D key its assignments (start | count << 16,
@@ -62,6 +63,12 @@
 @group(0) @binding(14) var<storage, read> field: array<u32>;
 @group(0) @binding(15) var<storage, read> potential: array<u32>;
 @group(0) @binding(16) var<storage, read> wind: array<u32>;
+// The obstacle cells (M7), one bit a cell laid out as the occupancy, where
+// the world has obstacles (params[50]); their surface entries in
+// increasing cell order (params[40] of them), four words each: the cell,
+// the normal's x and y in Q30, the restitution in Q16.
+@group(0) @binding(17) var<storage, read> obstacle: array<u32>;
+@group(0) @binding(18) var<storage, read> surfaces: array<u32>;
 
 const TURNS_AT: u32 = 256u;
 const KEYS_AT: u32 = 2304u;
@@ -382,11 +389,16 @@ struct Block {
     life: array<u32, 4>,
 }
 
-// Where a block lies (M3, M4): its cells beyond a wall face (with their
-// normals in Q30) and beyond an open one.
+// Where a block lies (M3, M4): its cells' raw coordinates (one beyond a
+// face where they lie there) and, resolved, inside the domain; its cells
+// beyond a wall face (with their normals in Q30), beyond an open one, and
+// the cells no particle may enter (beyond a wall, or an obstacle's).
 struct Site {
+    raw: array<vec2<i32>, 4>,
+    at: array<vec2<u32>, 4>,
     wall: u32,
     open: u32,
+    blocked: u32,
     normal: array<vec2<i32>, 4>,
 }
 
@@ -715,22 +727,89 @@ fn change(b: ptr<function, Block>, at: array<vec2<u32>, 4>, s: ptr<function, Str
     }
 }
 
-// M5.4 off a wall: eq. 9 with the wall's normal n (Q30) and restitution,
-// in fine units, then the clamp and M1. A particle asks for a wall cell
-// only moving into it (N.v < 0).
-fn reflect(q: vec2<i32>, n: vec2<i32>, s: ptr<function, Stream>, counts: ptr<function, Counts>) -> vec2<i32> {
-    let x = q << vec2<u32>(fine());
+// The surface entry of the cell at (x, y), by binary search: its index,
+// or the count where it has none.
+fn surface_of(x: u32, y: u32) -> u32 {
+    let cell = y * params[6] + x;
+    var lo = 0u;
+    var hi = params[40];
+    while lo < hi {
+        let mid = (lo + hi) / 2u;
+        let at = surfaces[4u * mid];
+        if at == cell {
+            return mid;
+        }
+        if at < cell {
+            lo = mid + 1u;
+        } else {
+            hi = mid;
+        }
+    }
+    return params[40];
+}
+
+// M5.4's test of a particle at raw (x, y) with working velocity v: whether
+// a cell along one axis of its velocity is neither an obstacle's nor
+// beyond a wall.
+fn axis_move_free(at: vec2<i32>, v: vec2<i32>) -> bool {
+    for (var k = 0; k < 2; k++) {
+        if v[k] == 0 {
+            continue;
+        }
+        var to = at;
+        to[k] += select(-1, 1, v[k] > 0);
+        let col = resolve(to.x, 0u, params[6]);
+        let row = resolve(to.y, 1u, params[7]);
+        if col.kind == 1u || row.kind == 1u {
+            continue; // a wall
+        }
+        if col.kind == 2u || row.kind == 2u || !is_obstacle(col.at, row.at) {
+            return true;
+        }
+    }
+    return false;
+}
+
+// M5.4: the particle in cell c wants the blocked cell t. Its surface: a
+// wall's normal and the walls' restitution, an obstacle cell's entry, or
+// (an obstacle cell without one) the direction back to the particle with
+// the walls' restitution. Where the particle already leaves that surface
+// (N.v >= 0), it keeps its velocity (nothing drawn) if N faces its cell
+// and it has a free cell along an axis of its velocity; otherwise it is
+// reflected off the face it came through. Eq. 9 in fine units, then the
+// clamp and M1.
+fn reflect_off(b: ptr<function, Block>, site: ptr<function, Site>, c: u32, t: u32, s: ptr<function, Stream>, counts: ptr<function, Counts>) {
+    let x = (*b).v[c] << vec2<u32>(fine());
+    var n = back_normal(c, t);
+    var e = bitcast<i32>(params[15]);
+    if ((*site).wall >> t & 1u) != 0u {
+        n = (*site).normal[t];
+    } else {
+        let i = surface_of((*site).at[t].x, (*site).at[t].y);
+        if i < params[40] {
+            n = vec2<i32>(bitcast<i32>(surfaces[4u * i + 1u]), bitcast<i32>(surfaces[4u * i + 2u]));
+            e = bitcast<i32>(surfaces[4u * i + 3u]);
+        }
+    }
+    if !is_negative64(dot_q30(x, n)) {
+        let back = back_normal(c, t);
+        let facing = dot_q30(n, back);
+        if !is_negative64(facing) && !is_zero64(facing) && axis_move_free((*site).raw[c], x) {
+            return;
+        }
+        n = back;
+    }
     let dot = dot_q30(x, n);
     var y = x;
-    if (dot.y >> 31u) != 0u {
+    if is_negative64(dot) {
         // dot >> 30 fits 32 bits: |x| < 2^28, |n| <= 2^30.
         let d = bitcast<i32>((dot.x >> 30u) | (dot.y << 2u));
-        let sigma = mulq(d, 65536 + bitcast<i32>(params[15]), 16u);
+        let sigma = mulq(d, 65536 + e, 16u);
         for (var k = 0; k < 2; k++) {
             y[k] = clamp(x[k] - mulq(sigma, n[k], 30u), -(1 << 30u), 1 << 30u);
         }
     }
-    return round_velocity(clamp_speed(y, counts), s);
+    (*b).v[c] = round_velocity(clamp_speed(y, counts), s);
 }
 
 // The exact dot product of a working velocity and a Q30 vector, 64 bits
@@ -839,8 +918,8 @@ fn desire(b: ptr<function, Block>, site: ptr<function, Site>, s: ptr<function, S
         }
         // M5.4 once both axes of the cell are decided.
         let m = want >> (2u * c) & 3u;
-        if (inward >> (i + 1u) & select(1u, 0u, i % 2u == 1u)) == 0u && m != 0u && ((*site).wall >> (c ^ m) & 1u) != 0u {
-            (*b).v[c] = reflect((*b).v[c], (*site).normal[c ^ m], s, counts);
+        if (inward >> (i + 1u) & select(1u, 0u, i % 2u == 1u)) == 0u && m != 0u && ((*site).blocked >> (c ^ m) & 1u) != 0u {
+            reflect_off(b, site, c, c ^ m, s, counts);
             want &= ~(3u << (2u * c));
         }
     }
@@ -918,9 +997,14 @@ fn resolve(raw: i32, k: u32, n: u32) -> Resolved {
     let high = raw >= i32(n);
     let f = face(k, high);
     if f == 0u {
-        return Resolved(select(n - 1u, 0u, high), 0u, 0);
+        return Resolved(u32(select(raw + i32(n), raw - i32(n), high)), 0u, 0);
     }
     return Resolved(0u, f, select(1, -1, high));
+}
+
+// Whether the cell at (x, y) inside the domain is an obstacle's.
+fn is_obstacle(x: u32, y: u32) -> bool {
+    return params[50] != 0u && (obstacle[y * params[8] + (x >> 5u)] >> (x & 31u) & 1u) != 0u;
 }
 
 @compute @workgroup_size(64)
@@ -1015,13 +1099,19 @@ fn step_2d(@builtin(global_invocation_id) id: vec3<u32>) {
         b.occ = 0u;
         site.wall = 0u;
         site.open = 0u;
+        site.blocked = 0u;
         for (var c = 0u; c < 4u; c++) {
             let col = cols[c & 1u];
             let row = rows[c >> 1u];
+            site.raw[c] = vec2<i32>(x0 + i32(c & 1u), y0 + i32(c >> 1u));
+            site.at[c] = vec2<u32>(col.at, row.at);
             b.v[c] = vec2<i32>(0, 0);
             site.normal[c] = vec2<i32>(0, 0);
             b.life[c] = 0u;
             if col.kind == 0u && row.kind == 0u {
+                if is_obstacle(col.at, row.at) {
+                    site.blocked |= 1u << c;
+                }
                 if occupied(col.at, row.at) != 0u {
                     b.occ |= 1u << c;
                     b.v[c] = velocity(col.at, row.at);
@@ -1034,6 +1124,7 @@ fn step_2d(@builtin(global_invocation_id) id: vec3<u32>) {
                 // A corner beyond a wall and an open face is a wall; its
                 // normal is the sum of the walls' inward normals, made unit.
                 site.wall |= 1u << c;
+                site.blocked |= 1u << c;
                 let n = vec2<i32>(select(0, col.inward, col.kind == 1u), select(0, row.inward, row.kind == 1u));
                 site.normal[c] = n * select(1 << 30u, DIAGONAL, n.x != 0 && n.y != 0);
             } else {
@@ -1050,13 +1141,9 @@ fn step_2d(@builtin(global_invocation_id) id: vec3<u32>) {
         s.gamma = sk.gamma;
         s.pool = vec2<u32>(0u, 0u);
         s.left = 0u;
-        var at: array<vec2<u32>, 4>;
-        for (var c = 0u; c < 4u; c++) {
-            at[c] = vec2<u32>(cols[c & 1u].at, rows[c >> 1u].at);
-        }
-        change(&b, at, &s, &block_counts);
+        change(&b, site.at, &s, &block_counts);
         let want = desire(&b, &site, &s, &block_counts);
-        let targets = assign(&b, site.wall, want, &s, &block_counts);
+        let targets = assign(&b, site.blocked, want, &s, &block_counts);
         if params[26] != 0u && want != 0u {
             contacts(&b, want, targets, &s, &block_counts);
         }
@@ -1172,7 +1259,7 @@ fn emit() {
         var free = 0u;
         for (var y = emitters[e + 1u]; y < emitters[e + 3u]; y++) {
             for (var x = emitters[e]; x < emitters[e + 2u]; x++) {
-                free += 1u - (occ_emit[y * row_u32 + (x >> 5u)] >> (x & 31u) & 1u);
+                free += select(1u - (occ_emit[y * row_u32 + (x >> 5u)] >> (x & 31u) & 1u), 0u, is_obstacle(x, y));
             }
         }
         let placing = select(free, wanted.x, wanted.y == 0u && wanted.x < free);
@@ -1181,7 +1268,7 @@ fn emit() {
         for (var y = emitters[e + 1u]; y < emitters[e + 3u]; y++) {
             for (var x = emitters[e]; x < emitters[e + 2u]; x++) {
                 let word = y * row_u32 + (x >> 5u);
-                if need == 0u || (occ_emit[word] >> (x & 31u) & 1u) != 0u {
+                if need == 0u || (occ_emit[word] >> (x & 31u) & 1u) != 0u || is_obstacle(x, y) {
                     continue;
                 }
                 let take = below(&s, left) < need;

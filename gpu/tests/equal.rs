@@ -13,10 +13,17 @@ fn gpu() -> Gpu {
 /// A 2D gas of `nx x ny` cells at `density`, velocities uniform in the
 /// square [-1, 1]^2 cut to the unit disc, from `seed`.
 fn gas(nx: u32, ny: u32, density: f64, seed: u64, edit: impl Fn(&mut Description)) -> WorldBox {
+    gas_around(nx, ny, density, seed, edit, |_| {})
+}
+
+/// [`gas`] in a world that `place` gives obstacles first: their cells get
+/// no particle.
+fn gas_around(nx: u32, ny: u32, density: f64, seed: u64, edit: impl Fn(&mut Description), place: impl Fn(&mut World)) -> WorldBox {
     let mut desc = Description::new_2d(nx, ny);
     desc.seed = seed;
     edit(&mut desc);
     let mut w = WorldBox::new(&desc).unwrap();
+    place(&mut w);
     let mut rng = mpca::rng::block_stream(seed, 99, 0);
     for y in 0..ny {
         for x in 0..nx {
@@ -29,7 +36,10 @@ fn gas(nx: u32, ny: u32, density: f64, seed: u64, edit: impl Fn(&mut Description
                         break;
                     }
                 }
-                w.add_particle([x, y, 0], v).unwrap();
+                match w.add_particle([x, y, 0], v) {
+                    Ok(()) | Err(mpca::Error::CellObstacle) => {}
+                    Err(e) => panic!("{e:?}"),
+                }
             }
         }
     }
@@ -431,5 +441,48 @@ fn force_fields_potentials_and_drag_step_as_on_the_cpu() {
         w.set_potential(&potential).unwrap();
         w.set_wind_field(&wind).unwrap();
         same_worlds(&mut w, 25, 1);
+    }
+}
+
+#[test]
+fn obstacles_step_as_on_the_cpu() {
+    // M5.4 off obstacles (M7): a disc, a box, a floor tilted by 30 degrees
+    // (a staircase, where particles leave the surface and keep their
+    // velocity, or turn back off the face they came through), a mask blob
+    // and a cell with a normal of its own; walls below and above, periodic
+    // x (the half-space seen across the seam), gravity, an emitter whose
+    // region holds obstacle cells; at both widths.
+    use mpca::Shape;
+    for quantization in [mpca::Quantization::Bits8, mpca::Quantization::Bits16] {
+        let mut w = gas_around(
+            64,
+            48,
+            0.35,
+            91,
+            |d| {
+                d.quantization = quantization;
+                d.boundary[1] = [mpca::Boundary::Wall; 2];
+                d.obstacles = true;
+                d.surface_capacity = 2000;
+                d.forces.uniform = true;
+                d.gravity = [0.0, 0.01, 0.0];
+                d.wall_restitution = 0.6;
+                d.emitter_capacity = 1;
+            },
+            |w| {
+                w.add_shape(Shape::Disc { centre: [20.0, 16.0], radius: 6.5 }, 0.9).unwrap();
+                w.add_shape(Shape::Box { min: [40.0, 8.0, 0.0], max: [47.0, 20.0, 1.0] }, 0.3).unwrap();
+                w.add_shape(Shape::HalfSpace { point: [0.0, 38.0, 0.0], normal: [-0.5, -0.866_025_4, 0.0] }, 0.7).unwrap();
+                let mut mask = vec![0u8; 64 * 48];
+                for (i, m) in mask.iter_mut().enumerate() {
+                    let (x, y) = ((i % 64) as i32 - 54, (i / 64) as i32 - 26);
+                    *m = u8::from(x * x + 2 * y * y <= 12);
+                }
+                w.add_obstacle_mask(&mask, 1.0).unwrap();
+                w.add_obstacle([30, 30, 0], [0.6, -0.8, 0.0], 0.5).unwrap();
+                w.add_emitter(mpca::Emitter { min: [16, 2, 0], max: [26, 12, 0], rate: 2.5, velocity: [0.0, 0.4, 0.0], spread: 0.2, mass: 1.0, lifetime: 0 }).unwrap();
+            },
+        );
+        same_worlds(&mut w, 40, 1);
     }
 }

@@ -11,6 +11,7 @@ use crate::api::desc::Drift;
 use crate::rules::emitter::{split_rate, EmitterStats};
 use crate::rules::fixed::{csqrt, divr, magnitude, parts, scaled, scaled_by, to_fine, unit_scale};
 use crate::rules::force::Swirl;
+use crate::rules::obstacle::{normal_q30, Surface};
 use crate::rules::quant::Quant;
 use crate::rules::rng::StepKey;
 use crate::step::convert_class;
@@ -76,6 +77,18 @@ pub struct VortexConstants {
     pub force: Option<(i32, i32)>,
     /// `(g, e)` of `Γ''`, where the drag's flow holds the vortex.
     pub flow: Option<(i32, i32)>,
+}
+
+/// A surface entry of an obstacle cell as M5.4 reads it (M1c): its
+/// cell, its normal in Q30 and its restitution in Q16.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SurfaceConstants {
+    /// Dense cell index `x + nx (y + ny z)`.
+    pub cell: u32,
+    /// `conv(n_k, 1, 30)`, within `±2^30`.
+    pub normal: [i32; 3],
+    /// `conv(e, 1, 16)`.
+    pub restitution: i32,
 }
 
 /// M5.1b's drag as the step reads it (M1c).
@@ -228,6 +241,21 @@ impl World {
     pub fn port_planes(&self) -> PortPlanes<'_> {
         let l = self.layout();
         PortPlanes { occupancy: self.plane(l.occupancy()), row_words: l.row_words, velocity: self.plane_bytes(l.velocity()), life: self.plane_bytes(l.life()) }
+    }
+
+    /// The obstacle cells (M7), one bit a cell laid out as the occupancy
+    /// ([`World::port_planes`]); empty in a world without obstacles.
+    pub fn port_obstacles(&self) -> &[u64] {
+        self.plane(self.layout().obstacle())
+    }
+
+    /// Surface entry `i` of the obstacles (M7), in increasing cell order,
+    /// as M5.4 reads it; `None` past the last.
+    pub fn port_surface(&self, i: usize) -> Option<SurfaceConstants> {
+        let l = self.layout();
+        let table: &[Surface] = self.plane(l.surface());
+        let entry = table[..(self.head.surfaces as usize).min(table.len())].get(i)?;
+        Some(SurfaceConstants { cell: entry.cell, normal: normal_q30(entry.normal), restitution: scaled(entry.restitution, 1.0, 16) as i32 })
     }
 
     /// The force field, potential and wind planes (M5.1, M5.1b).
