@@ -15,11 +15,12 @@
 //! mass on any faces: every force term (M5.1) and flow drag (M5.1b),
 //! collisions (M5.2 and M5.2b, any restitution), both drift rules (M5.3),
 //! reflection off walls and obstacles (M5.4, M7), the exact-fast assignment
-//! (M5.6), contacts (M5.7), exits through open faces, emitters and
-//! lifetimes (M6): the paper's aggregation, cluster and smoke scenes, the
-//! smoke with flow drag and the benchmark's gas. A description that needs
-//! any other part is refused when the world is made, as a CPU build without
-//! that part refuses it ([`mpca::Error::FeatureDisabled`]).
+//! (M5.6), contacts (M5.7), energy-neutral rounding (M1b), exits through
+//! open faces, emitters and lifetimes (M6): the paper's aggregation,
+//! cluster and smoke scenes, the smoke with flow drag and the benchmark's
+//! gas. A description that needs any other part is refused when the world
+//! is made, as a CPU build without that part refuses it
+//! ([`mpca::Error::FeatureDisabled`]).
 //!
 //! ```
 //! use mpca::{Description, WorldBox};
@@ -131,11 +132,10 @@ impl Gpu {
 
 /// Why this backend cannot run a description: `None` where it can.
 pub fn unsupported(d: &Description) -> Option<&'static str> {
-    let checks: [(bool, &'static str); 5] = [
+    let checks: [(bool, &'static str); 4] = [
         (d.dim == 2, "3D worlds"),
         (!d.per_particle_mass, "per-particle masses"),
         (d.method == Method::ExactFast, "an assignment other than exact-fast"),
-        (!d.energy_neutral, "energy-neutral rounding"),
         (d.identity == Identity::NONE, "ids, ages and tags"),
     ];
     checks.iter().find(|(ok, _)| !ok).map(|(_, what)| *what)
@@ -491,7 +491,7 @@ fn counters_of(host: &World) -> [u32; COUNTERS] {
 }
 
 /// The shader's parameters (`step2d.wgsl`).
-const PARAMS: usize = 51;
+const PARAMS: usize = 52;
 
 /// A face as the shader reads it: 0 periodic, 1 wall, 2 open.
 fn face(b: Boundary) -> u32 {
@@ -566,5 +566,6 @@ fn params(c: &StepConstants, d: &Description, d_emitters: u32, surfaces: u32) ->
         on(v.flow.is_some()),
         (c.unit >> c.fine) as u32,
         on(d.obstacles),
+        on(d.energy_neutral),
     ]
 }

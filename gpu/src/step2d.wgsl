@@ -25,7 +25,7 @@
 // top(Γ'') (g, e), 43 drag (M5.1b), 44 its weight C (Q16), 45-46 the
 // uniform wind U (fine units), 47 the flow holds the wind plane, 48 the
 // flow holds the vortex, 49 S (quanta to a unit speed), 40 the surface
-// entries, 50 obstacles.
+// entries, 50 obstacles, 51 energy-neutral rounding (M1b).
 @group(0) @binding(0) var<storage, read> params: array<u32>;
 // tables: 0..256 M5.3 move limits; 256..2304 the turns of M5.2 (cos, sin
 // as i32); 2304..3600 per 2D key its assignments (start | count << 16,
@@ -634,6 +634,54 @@ fn eqs_7_8(xa: vec2<i32>, xc: vec2<i32>, t: vec2<i32>) -> array<vec2<i32>, 2> {
     return out;
 }
 
+// floor(n / d) for 64-bit n and d (d not 0), one quotient bit a round.
+fn div64(n: vec2<u32>, d: vec2<u32>) -> vec2<u32> {
+    var rest = vec2<u32>(0u, 0u);
+    var q = vec2<u32>(0u, 0u);
+    for (var i = 63; i >= 0; i--) {
+        rest = shl64(rest, 1u) | vec2<u32>(shr64(n, u32(i)).x & 1u, 0u);
+        q = shl64(q, 1u);
+        if !lt64(rest, d) {
+            rest = sub64(rest, d);
+            q = q | vec2<u32>(1u, 0u);
+        }
+    }
+    return q;
+}
+
+// M1b (params[51]) on a pair's results a, b (one mass: shares of 2^15):
+// the relative velocity scaled about the centre of mass by lambda (Q30),
+// so that the kinetic energy given up is what the two roundings add on
+// average; momentum kept exactly.
+fn energy_neutral(pair: array<vec2<i32>, 2>) -> array<vec2<i32>, 2> {
+    let a = pair[0];
+    let b = pair[1];
+    let mask = (1u << fine()) - 1u;
+    var gain = vec2<u32>(0u, 0u);
+    for (var k = 0; k < 2; k++) {
+        for (var j = 0; j < 2; j++) {
+            let phi = u32(pair[j][k]) & mask;
+            gain = add64(gain, vec2<u32>(phi * ((1u << fine()) - phi), 0u));
+        }
+    }
+    let d = a - b;
+    // (sq(d) >> 16) ((2^15 2^15) >> 16), and (2^15 (G_a + G_b)) >> 16.
+    let kinetic = shl64(shr64(sq2(d), 16u), 14u);
+    let lost = shr64(gain, 1u);
+    var l = 0;
+    if lt64(lost, kinetic) {
+        let q = div64(shl64(lost, 32u), kinetic);
+        l = i32(isqrt64(shl64(sub64(vec2<u32>(0u, 1u), q), 28u)).x);
+    }
+    var out: array<vec2<i32>, 2>;
+    for (var k = 0; k < 2; k++) {
+        let v0 = b[k] + mulq(d[k], 32768, 16u);
+        out[0][k] = v0 + mulq(a[k] - v0, l, 30u);
+        out[1][k] = a[k] + b[k] - out[0][k];
+    }
+    return out;
+}
+
 // d turned by one of 1,024 angles, uniformly (10 bits): |d| R for M5.2.
 fn turned(d: vec2<i32>, s: ptr<function, Stream>) -> vec2<i32> {
     let j = bits(s, 10u);
@@ -667,6 +715,9 @@ fn collide(xa: vec2<i32>, xc: vec2<i32>, out: ptr<function, array<vec2<i32>, 2>>
         if !fits {
             pair = eqs_7_8(xa, xc, d);
         }
+    }
+    if params[51] != 0u {
+        pair = energy_neutral(pair);
     }
     (*out)[0] = clamp_speed(pair[0], counts);
     (*out)[1] = clamp_speed(pair[1], counts);
@@ -870,7 +921,10 @@ fn contacts(b: ptr<function, Block>, want: u32, targets: u32, s: ptr<function, S
         let n = sq2(d);
         let root = isqrt64(n).x;
         let length = i32(root + select(0u, 1u, lt64(vec2<u32>(root, 0u), sub64(n, mul32(root, root)))));
-        let pair = eqs_7_8(x[a], x[h], vec2<i32>(mulq(length, r.x, 30u), mulq(length, r.y, 30u)));
+        var pair = eqs_7_8(x[a], x[h], vec2<i32>(mulq(length, r.x, 30u), mulq(length, r.y, 30u)));
+        if params[51] != 0u {
+            pair = energy_neutral(pair);
+        }
         x[a] = clamp_speed(pair[0], counts);
         x[h] = clamp_speed(pair[1], counts);
         changed |= (1u << a) | (1u << h);

@@ -104,9 +104,9 @@ fn many_steps_between_syncs_step_as_on_the_cpu() {
 #[test]
 fn a_part_the_backend_does_not_run_is_refused() {
     let gpu = gpu();
-    let w = gas(8, 8, 0.2, 1, |d| d.energy_neutral = true);
+    let w = gas(8, 8, 0.2, 1, |d| d.method = mpca::Method::Greedy);
     assert!(matches!(GpuWorld::new(&gpu, &w), Err(mpca_gpu::Error::World(mpca::Error::FeatureDisabled))));
-    assert_eq!(mpca_gpu::unsupported(w.description()), Some("energy-neutral rounding"));
+    assert_eq!(mpca_gpu::unsupported(w.description()), Some("an assignment other than exact-fast"));
 }
 
 /// A scene of the paper as the paper ran it, compared every `every` steps.
@@ -301,7 +301,7 @@ fn a_world_moves_between_the_cpu_and_the_gpu_through_its_image_mid_run() {
     g.load(&image(&cpu)).unwrap();
     let before = g.sync().unwrap().state_hash();
     assert_eq!(before, cpu.state_hash());
-    for (other, why) in [(gas(50, 40, 0.4, 31, walls), mpca::Error::ImageMismatch), (gas(48, 40, 0.4, 31, |d| d.energy_neutral = true), mpca::Error::FeatureDisabled)] {
+    for (other, why) in [(gas(50, 40, 0.4, 31, walls), mpca::Error::ImageMismatch), (gas(48, 40, 0.4, 31, |d| d.method = mpca::Method::Greedy), mpca::Error::FeatureDisabled)] {
         assert!(matches!(g.load(&image(&other)), Err(mpca_gpu::Error::World(e)) if e == why));
         assert_eq!(g.sync().unwrap().state_hash(), before);
     }
@@ -335,11 +335,13 @@ fn sixteen_bit_velocities_step_as_on_the_cpu() {
 #[test]
 fn speed_limited_collisions_step_as_on_the_cpu() {
     // M5.2b: a dense elastic gas of particles up to nearly the unit
-    // speed, where tries are refused and drawn again, at both widths.
-    for quantization in [mpca::Quantization::Bits8, mpca::Quantization::Bits16] {
+    // speed, where tries are refused and drawn again, at both widths, with
+    // and without energy-neutral rounding (M1b: the elastic box of M10).
+    for (quantization, neutral) in [(mpca::Quantization::Bits8, false), (mpca::Quantization::Bits16, false), (mpca::Quantization::Bits8, true), (mpca::Quantization::Bits16, true)] {
         let mut w = gas(64, 32, 0.7, 51, |d| {
             d.collisions = mpca::Collisions::SpeedLimited;
             d.quantization = quantization;
+            d.energy_neutral = neutral;
         });
         same_worlds(&mut w, 20, 1);
     }
@@ -348,11 +350,13 @@ fn speed_limited_collisions_step_as_on_the_cpu() {
 #[test]
 fn contacts_step_as_on_the_cpu() {
     // M5.7: a dense inelastic pile under gravity in a box, where refused
-    // moves meet the particles placed in their cells, at both widths.
-    for quantization in [mpca::Quantization::Bits8, mpca::Quantization::Bits16] {
+    // moves meet the particles placed in their cells, at both widths; and
+    // with energy-neutral rounding (M1b) after every collision and contact.
+    for (quantization, neutral) in [(mpca::Quantization::Bits8, false), (mpca::Quantization::Bits16, false), (mpca::Quantization::Bits8, true), (mpca::Quantization::Bits16, true)] {
         let pile = |contacts| {
             gas(40, 40, 0.6, 61, |d| {
                 d.contacts = contacts;
+                d.energy_neutral = neutral;
                 d.restitution = 0.5;
                 d.quantization = quantization;
                 d.boundary[0] = [mpca::Boundary::Wall; 2];
