@@ -11,15 +11,15 @@
 //! planes and the counters down into it, which checks them, and from there
 //! come the hash, the statistics and the snapshot image.
 //!
-//! This version runs the 2D rule with 8-bit or 16-bit velocities and one
-//! mass on any faces: every force term (M5.1) and flow drag (M5.1b),
-//! collisions (M5.2 and M5.2b, any restitution), both drift rules (M5.3),
-//! reflection off walls and obstacles (M5.4, M7), the exact-fast assignment
-//! (M5.6), contacts (M5.7), energy-neutral rounding (M1b), exits through
-//! open faces, emitters and lifetimes (M6): the paper's aggregation,
-//! cluster and smoke scenes, the smoke with flow drag and the benchmark's
-//! gas. A description that needs any other part is refused when the world
-//! is made, as a CPU build without that part refuses it
+//! This version runs the 2D rule with 8-bit or 16-bit velocities, one mass
+//! or many (M9), on any faces: every force term (M5.1) and flow drag
+//! (M5.1b), collisions (M5.2 and M5.2b, any restitution), both drift rules
+//! (M5.3), reflection off walls and obstacles (M5.4, M7), the exact-fast
+//! assignment (M5.6), contacts (M5.7), energy-neutral rounding (M1b), exits
+//! through open faces, emitters and lifetimes (M6): the paper's
+//! aggregation, cluster and smoke scenes, the smoke with flow drag and the
+//! benchmark's gas. A description that needs any other part is refused when
+//! the world is made, as a CPU build without that part refuses it
 //! ([`mpca::Error::FeatureDisabled`]).
 //!
 //! ```
@@ -132,9 +132,8 @@ impl Gpu {
 
 /// Why this backend cannot run a description: `None` where it can.
 pub fn unsupported(d: &Description) -> Option<&'static str> {
-    let checks: [(bool, &'static str); 4] = [
+    let checks: [(bool, &'static str); 3] = [
         (d.dim == 2, "3D worlds"),
-        (!d.per_particle_mass, "per-particle masses"),
         (d.method == Method::ExactFast, "an assignment other than exact-fast"),
         (d.identity == Identity::NONE, "ids, ages and tags"),
     ];
@@ -216,6 +215,10 @@ pub struct GpuWorld {
     /// The obstacle cells and their surface entries (M7), as the world had
     /// them when made or loaded.
     obstacles: [wgpu::Buffer; 2],
+    /// The mass indices (M9), 16 bits a cell, where the world has masses
+    /// (a word otherwise), and the classes they stand for.
+    mass: [wgpu::Buffer; 2],
+    classes: wgpu::Buffer,
     counters: wgpu::Buffer,
     /// `groups[i]` reads pair member `i` and writes the other.
     groups: [wgpu::BindGroup; 2],
@@ -241,12 +244,14 @@ impl GpuWorld {
         let desc = *host.description();
         let (nx, ny) = (desc.size[0], desc.size[1]);
         let p = host.port_planes();
-        let (occupancy, velocity, life) = (bytemuck::cast_slice::<u64, u8>(p.occupancy).to_vec(), p.velocity.to_vec(), p.life.to_vec());
+        let (occupancy, velocity, life, mass) = (bytemuck::cast_slice::<u64, u8>(p.occupancy).to_vec(), p.velocity.to_vec(), p.life.to_vec(), widened(p.mass_index));
         let storage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
         let buffer = |label: &str, bytes: &[u8]| device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents: &padded(bytes), usage: storage });
         let occupancy = [buffer("occupancy 0", &occupancy), buffer("occupancy 1", &occupancy)];
         let velocity = [buffer("velocity 0", &velocity), buffer("velocity 1", &velocity)];
         let life = [buffer("life 0", &life), buffer("life 1", &life)];
+        let mass = [buffer("mass index 0", &mass), buffer("mass index 1", &mass)];
+        let classes = buffer("classes", bytemuck::cast_slice(&class_table(&host)));
         let f = host.port_fields();
         let fields = [buffer("force field", f.force), buffer("potential", f.potential), buffer("wind", f.wind)];
         // Room for every surface entry the world can hold: an image may
@@ -276,7 +281,7 @@ impl GpuWorld {
             let pipeline = pipeline_of("emit");
             let layout = pipeline.get_bind_group_layout(0);
             let group = |member: usize| {
-                let entries = [(0, &params), (6, &counters), (7, &occupancy[member]), (8, &velocity[member]), (9, &emitters), (10, &emitter_stats), (13, &life[member]), (17, &obstacles[0])];
+                let entries = [(0, &params), (6, &counters), (7, &occupancy[member]), (8, &velocity[member]), (9, &emitters), (10, &emitter_stats), (13, &life[member]), (17, &obstacles[0]), (22, &mass[member])];
                 let entries: Vec<wgpu::BindGroupEntry<'_>> = entries.iter().map(|&(binding, b)| wgpu::BindGroupEntry { binding, resource: b.as_entire_binding() }).collect();
                 device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("emit"), layout: &layout, entries: &entries })
             };
@@ -290,7 +295,7 @@ impl GpuWorld {
         let layout = pipeline.get_bind_group_layout(0);
         let group = |from: usize| {
             let to = 1 - from;
-            let entries = [(0, &params), (1, &tables), (2, &occupancy[from]), (3, &velocity[from]), (4, &occupancy[to]), (5, &velocity[to]), (6, &counters), (11, &life[from]), (12, &life[to]), (14, &fields[0]), (15, &fields[1]), (16, &fields[2]), (17, &obstacles[0]), (18, &obstacles[1])];
+            let entries = [(0, &params), (1, &tables), (2, &occupancy[from]), (3, &velocity[from]), (4, &occupancy[to]), (5, &velocity[to]), (6, &counters), (11, &life[from]), (12, &life[to]), (14, &fields[0]), (15, &fields[1]), (16, &fields[2]), (17, &obstacles[0]), (18, &obstacles[1]), (19, &classes), (20, &mass[from]), (21, &mass[to])];
             let entries: Vec<wgpu::BindGroupEntry<'_>> = entries.iter().map(|&(binding, b)| wgpu::BindGroupEntry { binding, resource: b.as_entire_binding() }).collect();
             device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("step"), layout: &layout, entries: &entries })
         };
@@ -313,6 +318,8 @@ impl GpuWorld {
             life,
             fields,
             obstacles,
+            mass,
+            classes,
             counters,
             groups,
             current: 0,
@@ -345,6 +352,8 @@ impl GpuWorld {
         queue.write_buffer(&self.occupancy[self.current], 0, bytemuck::cast_slice(p.occupancy));
         queue.write_buffer(&self.velocity[self.current], 0, &padded(p.velocity));
         queue.write_buffer(&self.life[self.current], 0, &padded(p.life));
+        queue.write_buffer(&self.mass[self.current], 0, &padded(&widened(p.mass_index)));
+        queue.write_buffer(&self.classes, 0, bytemuck::cast_slice(&class_table(&host)));
         let f = host.port_fields();
         for (buffer, plane) in self.fields.iter().zip([f.force, f.potential, f.wind]) {
             queue.write_buffer(buffer, 0, &padded(plane));
@@ -407,6 +416,7 @@ impl GpuWorld {
             let occupancy: Vec<u64> = self.gpu.read(&self.occupancy[self.current]).chunks_exact(8).map(|b| u64::from_le_bytes(b.try_into().expect("8 bytes"))).collect();
             let mut velocity = self.gpu.read(&self.velocity[self.current]);
             let mut life = self.gpu.read(&self.life[self.current]);
+            let mass = self.gpu.read(&self.mass[self.current]);
             let counters: Vec<u32> = bytemuck::cast_slice(&self.gpu.read(&self.counters)).to_vec();
             let stats: Vec<u64> = bytemuck::cast_slice::<u8, u32>(&self.gpu.read(&self.emitter_stats)).chunks_exact(2).map(|w| u64::from(w[0]) | u64::from(w[1]) << 32).collect();
             let emitters = emitter_count(&self.host);
@@ -415,6 +425,8 @@ impl GpuWorld {
             let planes = self.host.port_planes();
             velocity.truncate(planes.velocity.len());
             life.truncate(planes.life.len());
+            // 16 bits a cell on the GPU, a byte in the world.
+            let mass_index: Vec<u8> = mass.chunks_exact(2).take(planes.mass_index.len()).map(|h| h[0]).collect();
             let row_words = planes.row_words;
             let wide = |i: usize| u64::from(counters[i]) | u64::from(counters[i + 1]) << 32;
             if wide(13) != self.host.stats().step.wrapping_add(self.pending) {
@@ -432,7 +444,7 @@ impl GpuWorld {
                 shortfall: wide(EMITTED + 2),
                 expired: wide(EMITTED + 4),
             };
-            self.host.port_finish_steps(&PortPlanes { occupancy: &occupancy, row_words, velocity: &velocity, life: &life }, &counts, &emitted)?;
+            self.host.port_finish_steps(&PortPlanes { occupancy: &occupancy, row_words, velocity: &velocity, life: &life, mass_index: &mass_index }, &counts, &emitted)?;
             // Counted into the CPU copy: the GPU's start again from zero.
             self.gpu.queue.write_buffer(&self.counters, 0, &[0u8; 4 * COUNTED]);
             self.gpu.queue.write_buffer(&self.counters, 4 * EMITTED as u64, &[0u8; 24]);
@@ -465,6 +477,24 @@ fn surface_bytes(host: &World) -> Vec<u8> {
     bytemuck::cast_slice(&table).to_vec()
 }
 
+/// A plane of a byte a cell widened to 16 bits a cell, as the shader keeps
+/// mass indices (two cells a word: rows of an even width start on a word).
+fn widened(bytes: &[u8]) -> Vec<u8> {
+    bytes.iter().flat_map(|&b| [b, 0]).collect()
+}
+
+/// The shader's class table (`step2d.wgsl`): for each of the 256 mass
+/// indices its class (M1c) as 8 words.
+fn class_table(host: &World) -> Vec<u32> {
+    (0..=255u8)
+        .flat_map(|i| {
+            let c = host.port_class(i);
+            let (g, e) = c.swirl.unwrap_or_default();
+            [c.relative, c.energy.0, c.energy.1 as u32, c.push, g as u32, e as u32, 0, 0]
+        })
+        .collect()
+}
+
 /// The emitters `host` has.
 fn emitter_count(host: &World) -> usize {
     (0..).take_while(|&i| host.port_emitter(i).is_some()).count()
@@ -476,7 +506,7 @@ fn emitter_table(host: &World, capacity: usize) -> Vec<u32> {
     let mut table = vec![0u32; EMITTER * capacity];
     for (i, entry) in table.chunks_exact_mut(EMITTER).enumerate() {
         let Some(e) = host.port_emitter(i) else { break };
-        entry[..11].copy_from_slice(&[e.min[0], e.min[1], e.max[0], e.max[1], e.whole as u32, (e.whole >> 32) as u32, e.threshold, e.velocity[0] as u32, e.velocity[1] as u32, e.radius as u32, e.lifetime]);
+        entry[..12].copy_from_slice(&[e.min[0], e.min[1], e.max[0], e.max[1], e.whole as u32, (e.whole >> 32) as u32, e.threshold, e.velocity[0] as u32, e.velocity[1] as u32, e.radius as u32, e.lifetime, u32::from(e.mass_index)]);
     }
     table
 }
@@ -491,7 +521,7 @@ fn counters_of(host: &World) -> [u32; COUNTERS] {
 }
 
 /// The shader's parameters (`step2d.wgsl`).
-const PARAMS: usize = 52;
+const PARAMS: usize = 53;
 
 /// A face as the shader reads it: 0 periodic, 1 wall, 2 open.
 fn face(b: Boundary) -> u32 {
@@ -567,5 +597,6 @@ fn params(c: &StepConstants, d: &Description, d_emitters: u32, surfaces: u32) ->
         (c.unit >> c.fine) as u32,
         on(d.obstacles),
         on(d.energy_neutral),
+        on(d.per_particle_mass),
     ]
 }

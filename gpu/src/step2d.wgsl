@@ -25,7 +25,7 @@
 // top(Γ'') (g, e), 43 drag (M5.1b), 44 its weight C (Q16), 45-46 the
 // uniform wind U (fine units), 47 the flow holds the wind plane, 48 the
 // flow holds the vortex, 49 S (quanta to a unit speed), 40 the surface
-// entries, 50 obstacles, 51 energy-neutral rounding (M1b).
+// entries, 50 obstacles, 51 energy-neutral rounding (M1b), 52 masses.
 @group(0) @binding(0) var<storage, read> params: array<u32>;
 // tables: 0..256 M5.3 move limits; 256..2304 the turns of M5.2 (cos, sin
 // as i32); 2304..3600 per 2D key its assignments (start | count << 16,
@@ -47,7 +47,7 @@
 @group(0) @binding(8) var<storage, read_write> vel_emit: array<u32>;
 // Per emitter (M6), 16 words: min x, min y, max x, max y, the rate's whole
 // part (64 bits), its 24-bit threshold, velocity x, y and spread (fine
-// units), the lifetime of its particles.
+// units), the lifetime and the mass index of its particles.
 @group(0) @binding(9) var<storage, read> emitters: array<u32>;
 // Per emitter, 4 words: requested, delivered (64-bit pairs).
 @group(0) @binding(10) var<storage, read_write> emitter_stats: array<u32>;
@@ -69,6 +69,17 @@
 // the normal's x and y in Q30, the restitution in Q16.
 @group(0) @binding(17) var<storage, read> obstacle: array<u32>;
 @group(0) @binding(18) var<storage, read> surfaces: array<u32>;
+// Per mass index (256), 8 words of its class (M1c): the relative mass M,
+// the clamp's energy factor (significand, exponent), K (f32 bits), the
+// vortex force's top(Γ') (g, e). The world's one class in each entry
+// where it has one mass.
+@group(0) @binding(19) var<storage, read> classes: array<u32>;
+// Each particle's mass index, two cells a word (16 bits each), where the
+// world has masses (params[52]): what the step reads, what it writes, and
+// what the emitters write.
+@group(0) @binding(20) var<storage, read> mass_in: array<u32>;
+@group(0) @binding(21) var<storage, read_write> mass_out: array<u32>;
+@group(0) @binding(22) var<storage, read_write> mass_emit: array<u32>;
 
 const TURNS_AT: u32 = 256u;
 const KEYS_AT: u32 = 2304u;
@@ -306,7 +317,7 @@ struct Counts {
 }
 
 // M5.5: x clamped to the unit speed, counted.
-fn clamp_speed(x: vec2<i32>, counts: ptr<function, Counts>) -> vec2<i32> {
+fn clamp_speed(x: vec2<i32>, mass_class: u32, counts: ptr<function, Counts>) -> vec2<i32> {
     let unit = bitcast<i32>(params[11]);
     let s2 = sq2(x);
     let limit = mul32(u32(unit), u32(unit));
@@ -314,7 +325,7 @@ fn clamp_speed(x: vec2<i32>, counts: ptr<function, Counts>) -> vec2<i32> {
         return x;
     }
     (*counts).clamps += 1u;
-    let removed = count_times(sub64(s2, limit), params[12], bitcast<i32>(params[13]));
+    let removed = count_times(sub64(s2, limit), classes[8u * mass_class + 1u], bitcast<i32>(classes[8u * mass_class + 2u]));
     let total = add64((*counts).energy, removed);
     if lt64(total, removed) {
         (*counts).saturated = true;
@@ -387,6 +398,8 @@ struct Block {
     v: array<vec2<i32>, 4>,
     // Steps left (M6), where the world has lifetimes.
     life: array<u32, 4>,
+    // Mass indices (M9), where the world has masses; 0 otherwise.
+    mass: array<u32, 4>,
 }
 
 // Where a block lies (M3, M4): its cells' raw coordinates (one beyond a
@@ -544,16 +557,18 @@ fn to_fine(u: u32) -> i32 {
     return clamp64(conv(u, 0x3f800000u, params[49], i32(fine())), 1 << 30u);
 }
 
-// The potential at cell i as a push: conv(U, K S, F).
-fn potential_at(i: u32) -> vec2<u32> {
-    return conv(potential[i], params[37], params[49], i32(fine()));
+// The potential at cell i as a push for a class of K (f32 bits):
+// conv(U, K S, F).
+fn potential_at(i: u32, k_push: u32) -> vec2<u32> {
+    return conv(potential[i], k_push, params[49], i32(fine()));
 }
 
 // M5.1's push on the particle in cell (x, y): G (params[16..22]), the
 // force field's conv(f, K S, F), -grad U by central differences of the
 // converted potential (one-sided at a face that is not periodic), and the
 // vortex's push, where each is on; 64 bits a component.
-fn push_at(x: u32, y: u32) -> array<vec2<u32>, 3> {
+fn push_at(x: u32, y: u32, mass_class: u32) -> array<vec2<u32>, 3> {
+    let k_push = classes[8u * mass_class + 3u];
     let nx = params[6];
     let ny = params[7];
     let cell = y * nx + x;
@@ -563,7 +578,7 @@ fn push_at(x: u32, y: u32) -> array<vec2<u32>, 3> {
     }
     if params[39] != 0u {
         for (var k = 0u; k < 2u; k++) {
-            dv[k] = add64(dv[k], conv(field[2u * cell + k], params[37], params[49], i32(fine())));
+            dv[k] = add64(dv[k], conv(field[2u * cell + k], k_push, params[49], i32(fine())));
         }
     }
     if params[38] != 0u {
@@ -579,18 +594,18 @@ fn push_at(x: u32, y: u32) -> array<vec2<u32>, 3> {
             var g = vec2<u32>(0u, 0u);
             if lo_in && hi_in {
                 // An arithmetic shift by one of the 64-bit difference.
-                let d = sub64(potential_at(lo), potential_at(hi));
+                let d = sub64(potential_at(lo, k_push), potential_at(hi, k_push));
                 g = vec2<u32>((d.x >> 1u) | (d.y << 31u), bitcast<u32>(bitcast<i32>(d.y) >> 1u));
             } else if hi_in {
-                g = sub64(potential_at(cell), potential_at(hi));
+                g = sub64(potential_at(cell, k_push), potential_at(hi, k_push));
             } else if lo_in {
-                g = sub64(potential_at(lo), potential_at(cell));
+                g = sub64(potential_at(lo, k_push), potential_at(cell, k_push));
             }
             dv[k] = add64(dv[k], g);
         }
     }
     if params[27] != 0u {
-        let t = swirl(x, y, bitcast<i32>(params[33]), bitcast<i32>(params[34]));
+        let t = swirl(x, y, bitcast<i32>(classes[8u * mass_class + 4u]), bitcast<i32>(classes[8u * mass_class + 5u]));
         dv[0] = add64(dv[0], t[0]);
         dv[1] = add64(dv[1], t[1]);
     }
@@ -619,17 +634,69 @@ fn flow_at(x: u32, y: u32) -> vec2<i32> {
     return vec2<i32>(clamp64(u[0], 1 << 30u), clamp64(u[1], 1 << 30u));
 }
 
-// Eqs. 7-8 for the pair (a, c) with working velocities xa, xc and
-// |xa - xc| R = t, one mass: out[0] for a, out[1] for c, the pair's
-// momentum kept exactly.
-fn eqs_7_8(xa: vec2<i32>, xc: vec2<i32>, t: vec2<i32>) -> array<vec2<i32>, 2> {
+// The world has masses (params[52]).
+fn masses_on() -> bool {
+    return params[52] != 0u;
+}
+
+// The mass shares (A, B) of a pair of relative masses (M1c), Q16; halves
+// in a world of one mass.
+fn shares(ma: u32, mb: u32) -> vec2<i32> {
+    if !masses_on() {
+        return vec2<i32>(32768, 32768);
+    }
+    // Each at most 2^24: the sum fits a word.
+    let total = vec2<u32>(max(ma + mb, 1u), 0u);
+    let a = i32(div64(add64(shl64(vec2<u32>(ma, 0u), 16u), shr64(total, 1u)), total).x);
+    return vec2<i32>(a, 65536 - a);
+}
+
+// floor(n / d) for a signed 64-bit n and 0 < d < 2^31, the result within
+// 32 bits.
+fn floor_div(n: vec2<u32>, d: u32) -> i32 {
+    if is_negative64(n) {
+        return -i32(div64(add64(neg64(n), vec2<u32>(d - 1u, 0u)), vec2<u32>(d, 0u)).x);
+    }
+    return i32(div64(n, vec2<u32>(d, 0u)).x);
+}
+
+// The heavier particle's component after the lighter one went from light
+// to light2 (M1c): heavy + M_l (light - light2) / M_h, rounded to nearest.
+fn balance(heavy: i32, light: i32, light2: i32, mh: u32, ml: u32) -> i32 {
+    let diff = light - light2;
+    var n = mul32(ml, u32(abs(diff)));
+    if diff < 0 {
+        n = neg64(n);
+    }
+    let m = max(mh, 1u);
+    return heavy + floor_div(add64(shl64(n, 1u), vec2<u32>(m, 0u)), 2u * m);
+}
+
+// A pair's components after a stage gave them a and b from va and vb:
+// momentum kept exactly with one mass; with masses, the heavier balanced
+// against the lighter (equal masses are the one-mass rule exactly).
+fn conserve(va: i32, vb: i32, a: i32, b: i32, ma: u32, mb: u32) -> vec2<i32> {
+    if !masses_on() {
+        return vec2<i32>(a, va + vb - a);
+    }
+    if ma > mb {
+        return vec2<i32>(balance(va, vb, b, ma, mb), b);
+    }
+    return vec2<i32>(a, balance(vb, va, a, mb, ma));
+}
+
+// Eqs. 7-8 for the pair (a, c) with working velocities xa, xc, relative
+// masses ma, mc and |xa - xc| R = t: out[0] for a, out[1] for c.
+fn eqs_7_8(xa: vec2<i32>, xc: vec2<i32>, t: vec2<i32>, ma: u32, mc: u32) -> array<vec2<i32>, 2> {
     let e = bitcast<i32>(params[10]);
+    let sh = shares(ma, mc);
     var out: array<vec2<i32>, 2>;
     for (var k = 0; k < 2; k++) {
-        let v0 = xc[k] + mulq(xa[k] - xc[k], 32768, 16u);
+        let v0 = xc[k] + mulq(xa[k] - xc[k], sh.x, 16u);
         let u = mulq(t[k], e, 16u);
-        out[0][k] = v0 + mulq(u, 32768, 16u);
-        out[1][k] = xa[k] + xc[k] - out[0][k];
+        let kept = conserve(xa[k], xc[k], v0 + mulq(u, sh.y, 16u), v0 - mulq(u, sh.x, 16u), ma, mc);
+        out[0][k] = kept.x;
+        out[1][k] = kept.y;
     }
     return out;
 }
@@ -653,21 +720,21 @@ fn div64(n: vec2<u32>, d: vec2<u32>) -> vec2<u32> {
 // the relative velocity scaled about the centre of mass by lambda (Q30),
 // so that the kinetic energy given up is what the two roundings add on
 // average; momentum kept exactly.
-fn energy_neutral(pair: array<vec2<i32>, 2>) -> array<vec2<i32>, 2> {
+fn energy_neutral(pair: array<vec2<i32>, 2>, ma: u32, mb: u32) -> array<vec2<i32>, 2> {
     let a = pair[0];
     let b = pair[1];
+    let sh = shares(ma, mb);
     let mask = (1u << fine()) - 1u;
-    var gain = vec2<u32>(0u, 0u);
-    for (var k = 0; k < 2; k++) {
-        for (var j = 0; j < 2; j++) {
+    var gain = array<vec2<u32>, 2>(vec2<u32>(0u, 0u), vec2<u32>(0u, 0u));
+    for (var j = 0; j < 2; j++) {
+        for (var k = 0; k < 2; k++) {
             let phi = u32(pair[j][k]) & mask;
-            gain = add64(gain, vec2<u32>(phi * ((1u << fine()) - phi), 0u));
+            gain[j] = add64(gain[j], vec2<u32>(phi * ((1u << fine()) - phi), 0u));
         }
     }
     let d = a - b;
-    // (sq(d) >> 16) ((2^15 2^15) >> 16), and (2^15 (G_a + G_b)) >> 16.
-    let kinetic = shl64(shr64(sq2(d), 16u), 14u);
-    let lost = shr64(gain, 1u);
+    let kinetic = mul64(shr64(sq2(d), 16u), vec2<u32>((u32(sh.x) * u32(sh.y)) >> 16u, 0u));
+    let lost = shr64(add64(mul64(vec2<u32>(u32(sh.x), 0u), gain[0]), mul64(vec2<u32>(u32(sh.y), 0u), gain[1])), 16u);
     var l = 0;
     if lt64(lost, kinetic) {
         let q = div64(shl64(lost, 32u), kinetic);
@@ -675,9 +742,10 @@ fn energy_neutral(pair: array<vec2<i32>, 2>) -> array<vec2<i32>, 2> {
     }
     var out: array<vec2<i32>, 2>;
     for (var k = 0; k < 2; k++) {
-        let v0 = b[k] + mulq(d[k], 32768, 16u);
-        out[0][k] = v0 + mulq(a[k] - v0, l, 30u);
-        out[1][k] = a[k] + b[k] - out[0][k];
+        let v0 = b[k] + mulq(d[k], sh.x, 16u);
+        let kept = conserve(a[k], b[k], v0 + mulq(a[k] - v0, l, 30u), v0 + mulq(b[k] - v0, l, 30u), ma, mb);
+        out[0][k] = kept.x;
+        out[1][k] = kept.y;
     }
     return out;
 }
@@ -695,8 +763,10 @@ fn turned(d: vec2<i32>, s: ptr<function, Stream>) -> vec2<i32> {
 // limit L, params[25], at most 16 times, then along xa - xc), both clamped.
 // False where the pair has one velocity within the speed limit (nothing
 // drawn, nothing changed).
-fn collide(xa: vec2<i32>, xc: vec2<i32>, out: ptr<function, array<vec2<i32>, 2>>, s: ptr<function, Stream>, counts: ptr<function, Counts>) -> bool {
+fn collide(xa: vec2<i32>, xc: vec2<i32>, ca: u32, cc: u32, out: ptr<function, array<vec2<i32>, 2>>, s: ptr<function, Stream>, counts: ptr<function, Counts>) -> bool {
     (*counts).collisions += 1u;
+    let ma = classes[8u * ca];
+    let mc = classes[8u * cc];
     let unit = bitcast<i32>(params[11]);
     if all(xa == xc) && !lt64(mul32(u32(unit), u32(unit)), sq2(xa)) {
         return false;
@@ -704,23 +774,23 @@ fn collide(xa: vec2<i32>, xc: vec2<i32>, out: ptr<function, array<vec2<i32>, 2>>
     let d = xa - xc;
     var pair: array<vec2<i32>, 2>;
     if params[24] == 0u {
-        pair = eqs_7_8(xa, xc, turned(d, s));
+        pair = eqs_7_8(xa, xc, turned(d, s), ma, mc);
     } else {
         let limit2 = mul32(params[25], params[25]);
         var fits = false;
         for (var i = 0; i < 16 && !fits; i++) {
-            pair = eqs_7_8(xa, xc, turned(d, s));
+            pair = eqs_7_8(xa, xc, turned(d, s), ma, mc);
             fits = !lt64(limit2, sq2(pair[0])) && !lt64(limit2, sq2(pair[1]));
         }
         if !fits {
-            pair = eqs_7_8(xa, xc, d);
+            pair = eqs_7_8(xa, xc, d, ma, mc);
         }
     }
     if params[51] != 0u {
-        pair = energy_neutral(pair);
+        pair = energy_neutral(pair, ma, mc);
     }
-    (*out)[0] = clamp_speed(pair[0], counts);
-    (*out)[1] = clamp_speed(pair[1], counts);
+    (*out)[0] = clamp_speed(pair[0], ca, counts);
+    (*out)[1] = clamp_speed(pair[1], cc, counts);
     return true;
 }
 
@@ -733,9 +803,9 @@ fn change(b: ptr<function, Block>, at: array<vec2<u32>, 4>, s: ptr<function, Str
         x[c] = (*b).v[c] << vec2<u32>(fine());
         if params[22] != 0u && ((*b).occ >> c & 1u) != 0u {
             // A push of exactly zero touches nothing (M5.1).
-            let dv = push_at(at[c].x, at[c].y);
+            let dv = push_at(at[c].x, at[c].y, (*b).mass[c]);
             if !is_zero64(dv[0] | dv[1] | dv[2]) {
-                x[c] = clamp_speed(pushed(x[c], dv), counts);
+                x[c] = clamp_speed(pushed(x[c], dv), (*b).mass[c], counts);
                 changed |= 1u << c;
             }
         }
@@ -755,7 +825,7 @@ fn change(b: ptr<function, Block>, at: array<vec2<u32>, 4>, s: ptr<function, Str
                 let sum = add64(vec2<u32>(bitcast<u32>(a), select(0u, 0xffffffffu, a < 0)), vec2<u32>(bitcast<u32>(w), select(0u, 0xffffffffu, w < 0)));
                 y[k] = clamp64(sum, 1 << 30u);
             }
-            x[c] = clamp_speed(y, counts);
+            x[c] = clamp_speed(y, (*b).mass[c], counts);
             changed |= 1u << c;
         }
     }
@@ -765,7 +835,7 @@ fn change(b: ptr<function, Block>, at: array<vec2<u32>, 4>, s: ptr<function, Str
         let a = PAIR_A[p];
         let c = PAIR_B[p];
         var out: array<vec2<i32>, 2>;
-        if ((*b).occ >> a & (*b).occ >> c & 1u) != 0u && collide(x[a], x[c], &out, s, counts) {
+        if ((*b).occ >> a & (*b).occ >> c & 1u) != 0u && collide(x[a], x[c], (*b).mass[a], (*b).mass[c], &out, s, counts) {
             x[a] = out[0];
             x[c] = out[1];
             changed |= (1u << a) | (1u << c);
@@ -860,7 +930,7 @@ fn reflect_off(b: ptr<function, Block>, site: ptr<function, Site>, c: u32, t: u3
             y[k] = clamp(x[k] - mulq(sigma, n[k], 30u), -(1 << 30u), 1 << 30u);
         }
     }
-    (*b).v[c] = round_velocity(clamp_speed(y, counts), s);
+    (*b).v[c] = round_velocity(clamp_speed(y, (*b).mass[c], counts), s);
 }
 
 // The exact dot product of a working velocity and a Q30 vector, 64 bits
@@ -921,12 +991,14 @@ fn contacts(b: ptr<function, Block>, want: u32, targets: u32, s: ptr<function, S
         let n = sq2(d);
         let root = isqrt64(n).x;
         let length = i32(root + select(0u, 1u, lt64(vec2<u32>(root, 0u), sub64(n, mul32(root, root)))));
-        var pair = eqs_7_8(x[a], x[h], vec2<i32>(mulq(length, r.x, 30u), mulq(length, r.y, 30u)));
+        let ca = (*b).mass[a];
+        let ch = (*b).mass[h];
+        var pair = eqs_7_8(x[a], x[h], vec2<i32>(mulq(length, r.x, 30u), mulq(length, r.y, 30u)), classes[8u * ca], classes[8u * ch]);
         if params[51] != 0u {
-            pair = energy_neutral(pair);
+            pair = energy_neutral(pair, classes[8u * ca], classes[8u * ch]);
         }
-        x[a] = clamp_speed(pair[0], counts);
-        x[h] = clamp_speed(pair[1], counts);
+        x[a] = clamp_speed(pair[0], ca, counts);
+        x[h] = clamp_speed(pair[1], ch, counts);
         changed |= (1u << a) | (1u << h);
     }
     for (var c = 0u; c < 4u; c++) {
@@ -1119,6 +1191,7 @@ fn step_2d(@builtin(global_invocation_id) id: vec3<u32>) {
     // lifetimes, 16.
     var out_vel: array<array<u32, 32>, 2>;
     var out_life: array<array<u32, 16>, 2>;
+    var out_mass: array<array<u32, 16>, 2>;
     for (var i = 0u; i < 32u; i++) {
         out_vel[0][i] = 0u;
         out_vel[1][i] = 0u;
@@ -1126,6 +1199,8 @@ fn step_2d(@builtin(global_invocation_id) id: vec3<u32>) {
     for (var i = 0u; i < 16u; i++) {
         out_life[0][i] = 0u;
         out_life[1][i] = 0u;
+        out_mass[0][i] = 0u;
+        out_mass[1][i] = 0u;
     }
     var counts = Counts(0u, 0u, vec2<u32>(0u, 0u), false, 0u, 0u, 0u, 0u);
     let sk = step_key(vec2<u32>(params[0], params[1]), step);
@@ -1162,6 +1237,7 @@ fn step_2d(@builtin(global_invocation_id) id: vec3<u32>) {
             b.v[c] = vec2<i32>(0, 0);
             site.normal[c] = vec2<i32>(0, 0);
             b.life[c] = 0u;
+            b.mass[c] = 0u;
             if col.kind == 0u && row.kind == 0u {
                 if is_obstacle(col.at, row.at) {
                     site.blocked |= 1u << c;
@@ -1169,9 +1245,12 @@ fn step_2d(@builtin(global_invocation_id) id: vec3<u32>) {
                 if occupied(col.at, row.at) != 0u {
                     b.occ |= 1u << c;
                     b.v[c] = velocity(col.at, row.at);
+                    let i = row.at * nx + col.at;
                     if params[36] != 0u {
-                        let i = row.at * nx + col.at;
                         b.life[c] = life_in[i >> 1u] >> (16u * (i & 1u)) & 0xffffu;
+                    }
+                    if masses_on() {
+                        b.mass[c] = mass_in[i >> 1u] >> (16u * (i & 1u)) & 0xffu;
                     }
                 }
             } else if col.kind == 1u || row.kind == 1u {
@@ -1227,6 +1306,7 @@ fn step_2d(@builtin(global_invocation_id) id: vec3<u32>) {
                 out_vel[row][(x - lo) >> 1u] |= byte_pair << (16u * (x & 1u));
             }
             out_life[row][(x - lo) >> 1u] |= (max(b.life[c], 1u) - 1u) << (16u * (x & 1u));
+            out_mass[row][(x - lo) >> 1u] |= b.mass[c] << (16u * (x & 1u));
         }
         // Counted by the invocation that owns the block's first cell inside.
         let owner = u32(max(x0, 0));
@@ -1253,10 +1333,13 @@ fn step_2d(@builtin(global_invocation_id) id: vec3<u32>) {
         for (var k = 0u; k < words; k++) {
             vel_out[base + k] = out_vel[row][k];
         }
-        if params[36] != 0u {
-            let first = (rows[row].at * nx + lo) >> 1u;
-            for (var k = 0u; k < (hi - lo) / 2u; k++) {
+        let first = (rows[row].at * nx + lo) >> 1u;
+        for (var k = 0u; k < (hi - lo) / 2u; k++) {
+            if params[36] != 0u {
                 life_out[first + k] = out_life[row][k];
+            }
+            if masses_on() {
+                mass_out[first + k] = out_mass[row][k];
             }
         }
     }
@@ -1361,9 +1444,12 @@ fn emit() {
                     let pair = (u32(q.x) & 0xffu) | (u32(q.y) & 0xffu) << 8u;
                     vel_emit[cell >> 1u] = (vel_emit[cell >> 1u] & ~(0xffffu << shift)) | pair << shift;
                 }
+                let half = 16u * (cell & 1u);
                 if params[36] != 0u {
-                    let shift = 16u * (cell & 1u);
-                    life_emit[cell >> 1u] = (life_emit[cell >> 1u] & ~(0xffffu << shift)) | (emitters[e + 10u] & 0xffffu) << shift;
+                    life_emit[cell >> 1u] = (life_emit[cell >> 1u] & ~(0xffffu << half)) | (emitters[e + 10u] & 0xffffu) << half;
+                }
+                if masses_on() {
+                    mass_emit[cell >> 1u] = (mass_emit[cell >> 1u] & ~(0xffffu << half)) | (emitters[e + 11u] & 0xffu) << half;
                 }
             }
         }

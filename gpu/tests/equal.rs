@@ -186,23 +186,33 @@ fn planes_that_are_not_a_world_are_refused_and_change_nothing() {
     lost[first] &= lost[first] - 1;
     cases.push((lost.clone(), velocity.clone(), &[], mpca::Error::ImageInvalid));
     for (o, v, life, want) in cases {
-        let planes = PortPlanes { occupancy: &o, row_words, velocity: &v, life };
+        let planes = PortPlanes { occupancy: &o, row_words, velocity: &v, life, mass_index: &[] };
         assert_eq!(w.port_finish_steps(&planes, &one, &[]), Err(want));
         assert_eq!((w.state_hash(), w.stats()), (hash, stats));
     }
     // One particle fewer is what one exit (or one expiry) leaves.
-    let planes = PortPlanes { occupancy: &lost, row_words, velocity: &velocity, life: &[] };
+    let planes = PortPlanes { occupancy: &lost, row_words, velocity: &velocity, life: &[], mass_index: &[] };
     w.port_finish_steps(&planes, &StepCounts { steps: 1, exited: 1, ..StepCounts::default() }, &[]).unwrap();
     assert_eq!(w.stats().particles, stats.particles - 1);
-    // A world whose particles carry a mass index: the planes cannot say
-    // where it went.
+    // A mass index the world has no class for.
     let mut heavy = gas(8, 8, 0.4, 3, |d| d.per_particle_mass = true);
-    let (o, v) = {
+    let (o, v, mut m) = {
         let p = heavy.port_planes();
+        (p.occupancy.to_vec(), p.velocity.to_vec(), p.mass_index.to_vec())
+    };
+    let cell = o[0].trailing_zeros() as usize;
+    m[cell] = 1;
+    let planes = PortPlanes { occupancy: &o, row_words: 1, velocity: &v, life: &[], mass_index: &m };
+    assert_eq!(heavy.port_finish_steps(&planes, &one, &[]), Err(mpca::Error::ImageInvalid));
+    // A world whose particles carry ids: the planes cannot say where they
+    // went.
+    let mut named = gas(8, 8, 0.4, 3, |d| d.identity = mpca::Identity::IDS);
+    let (o, v) = {
+        let p = named.port_planes();
         (p.occupancy.to_vec(), p.velocity.to_vec())
     };
-    let planes = PortPlanes { occupancy: &o, row_words: 1, velocity: &v, life: &[] };
-    assert_eq!(heavy.port_finish_steps(&planes, &one, &[]), Err(mpca::Error::NotEnabled));
+    let planes = PortPlanes { occupancy: &o, row_words: 1, velocity: &v, life: &[], mass_index: &[] };
+    assert_eq!(named.port_finish_steps(&planes, &one, &[]), Err(mpca::Error::NotEnabled));
 }
 
 #[test]
@@ -488,5 +498,53 @@ fn obstacles_step_as_on_the_cpu() {
             },
         );
         same_worlds(&mut w, 40, 1);
+    }
+}
+
+#[test]
+fn masses_step_as_on_the_cpu() {
+    // M9's mass classes: particles of five masses (1e-3 to 40, so shares
+    // far from halves and the heavier balanced against the lighter), with
+    // gravity, a force field and a potential (divided by each mass), the
+    // vortex force, contacts and energy-neutral rounding, an emitter of
+    // its own mass; walls and an open face; at both widths.
+    for quantization in [mpca::Quantization::Bits8, mpca::Quantization::Bits16] {
+        let masses = [1.0f32, 40.0, 0.001, 2.5, 7.0];
+        let mut w = gas_around(
+            40,
+            30,
+            0.0,
+            101,
+            |d| {
+                d.quantization = quantization;
+                d.per_particle_mass = true;
+                d.mass_classes = 8;
+                d.boundary[1] = [mpca::Boundary::Wall, mpca::Boundary::Open];
+                d.forces = mpca::Forces { uniform: true, field: true, potential: true, vortex: true };
+                d.gravity = [0.0, 0.005, 0.0];
+                d.vortex = mpca::Vortex { centre: [20.0, 15.0], core_radius: 5.0, circulation: 2.0 };
+                d.contacts = true;
+                d.energy_neutral = true;
+                d.emitter_capacity = 1;
+                d.restitution = 0.8;
+            },
+            |_| {},
+        );
+        let mut rng = mpca::rng::block_stream(102, 0, 0);
+        for y in 0..30 {
+            for x in 0..40 {
+                if rng.bits(8) < 110 {
+                    let v = [rng.bits(16) as f32 / 65536.0 - 0.5, rng.bits(16) as f32 / 65536.0 - 0.5, 0.0];
+                    w.add_particle_with_mass([x, y, 0], v, masses[rng.below(5) as usize]).unwrap();
+                }
+            }
+        }
+        let cells = 40 * 30;
+        let force: Vec<f32> = (0..2 * cells).map(|i| ((i * 37 % 101) as f32 - 50.0) * 2e-4).collect();
+        let potential: Vec<f32> = (0..cells).map(|i| ((i * 53 % 97) as f32) * 1e-3).collect();
+        w.set_force_field(&force).unwrap();
+        w.set_potential(&potential).unwrap();
+        w.add_emitter(mpca::Emitter { min: [5, 20, 0], max: [12, 26, 0], rate: 1.3, velocity: [0.1, -0.2, 0.0], spread: 0.1, mass: 2.5, lifetime: 0 }).unwrap();
+        same_worlds(&mut w, 30, 1);
     }
 }

@@ -119,6 +119,8 @@ pub struct EmitterConstants {
     pub radius: i32,
     /// Steps its particles live, 0 for ever.
     pub lifetime: u32,
+    /// The mass index its particles get (M9).
+    pub mass_index: u8,
 }
 
 /// What steps run elsewhere counted (the fields of [`crate::Stats`] of the
@@ -161,6 +163,23 @@ pub struct PortPlanes<'a> {
     /// The steps each particle has left to live (M6), two bytes a cell (0
     /// for no limit); empty in a world without lifetimes.
     pub life: &'a [u8],
+    /// Each particle's mass class (M9), a byte a cell; empty in a world
+    /// of one mass.
+    pub mass_index: &'a [u8],
+}
+
+/// A mass class as a step reads it (M1c).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ClassConstants {
+    /// `M`: the mass relative to the largest in use, `2^24` for that one.
+    pub relative: u32,
+    /// M5.5's energy factor `h = m 2^e`, as [`StepConstants::energy`].
+    pub energy: (u32, i32),
+    /// `K = quot(dt, m)`, as the bits of its `f32`.
+    pub push: u32,
+    /// The vortex force's strength for this class, `top(Γ')` as `(g, e)`,
+    /// where the force is on.
+    pub swirl: Option<(i32, i32)>,
 }
 
 /// A world's planes of `f32` settings per cell (M5.1, M5.1b), as their
@@ -223,7 +242,8 @@ impl World {
 
     /// Emitter `i` as a step reads it (M6, M1c), `None` past the last.
     pub fn port_emitter(&self, i: usize) -> Option<EmitterConstants> {
-        let e = self.slots().get(i)?.emitter;
+        let slot = self.slots().get(i)?;
+        let e = slot.emitter;
         let scale = unit_scale(crate::rules::quant::unit_of(self.head.desc.quantization));
         let (whole, threshold) = split_rate(e.rate);
         Some(EmitterConstants {
@@ -234,13 +254,43 @@ impl World {
             velocity: e.velocity.map(|v| to_fine(v, scale)),
             radius: to_fine(e.spread, scale),
             lifetime: e.lifetime,
+            mass_index: slot.mass_index(),
         })
     }
 
     /// The occupancy, velocity and lifetime planes, to copy a world out.
     pub fn port_planes(&self) -> PortPlanes<'_> {
         let l = self.layout();
-        PortPlanes { occupancy: self.plane(l.occupancy()), row_words: l.row_words, velocity: self.plane_bytes(l.velocity()), life: self.plane_bytes(l.life()) }
+        PortPlanes {
+            occupancy: self.plane(l.occupancy()),
+            row_words: l.row_words,
+            velocity: self.plane_bytes(l.velocity()),
+            life: self.plane_bytes(l.life()),
+            mass_index: self.plane_bytes(l.mass_index()),
+        }
+    }
+
+    /// Mass class `i` as a step reads it (M1c): a class in use, or, for an
+    /// index the world has no class for, the class a step gives such a
+    /// particle (the first).
+    pub fn port_class(&self, i: u8) -> ClassConstants {
+        let desc = &self.head.desc;
+        let unit = crate::rules::quant::unit_of(desc.quantization);
+        let scale = (unit_scale(unit).0, unit_scale(unit).1);
+        let table: &[f32] = self.plane(self.layout().mass_table());
+        let used = if desc.has_masses() { &table[..(self.head.masses as usize).min(desc.mass_classes as usize).min(table.len())] } else { &[] };
+        // Masses are positive (checked): their bits order them as numbers.
+        let largest = magnitude(f32::from_bits(used.iter().fold(desc.mass.to_bits() * u32::from(used.is_empty()), |a, &m| a.max(m.to_bits()))));
+        let mass = used.get(usize::from(i)).or(used.first()).map_or(magnitude(desc.mass), |&m| magnitude(m));
+        let swirl = (cfg!(feature = "vortex") && desc.forces.vortex).then(|| Swirl::of(&desc.vortex));
+        let class = convert_class(mass, largest, desc.dt, scale, swirl);
+        let (_, m, e) = parts(class.energy);
+        ClassConstants {
+            relative: class.relative,
+            energy: (m as u32, e),
+            push: class.push.to_bits(),
+            swirl: swirl.map(|_| (class.swirl.g, class.swirl.e)),
+        }
     }
 
     /// The obstacle cells (M7), one bit a cell laid out as the occupancy
@@ -272,22 +322,23 @@ impl World {
     /// emitter).
     ///
     /// Refused, with the world unchanged: planes of the wrong length
-    /// (`BadLength`); a world whose particles carry more than a velocity
-    /// and a lifetime (masses, ids, ages or tags: `NotEnabled`, since the
-    /// planes do not say where those went); a bit set beyond a row's end, a
+    /// (`BadLength`); a world whose particles carry ids, ages or tags
+    /// (`NotEnabled`, since the planes do not say where those went); a
+    /// mass index the world has no class for, a bit set beyond a row's end, a
     /// particle on an obstacle, a stored component beyond the storage's
     /// range, or a particle count other than the world's with the emitted
     /// and without the exits and expiries (`ImageInvalid`).
     pub fn port_finish_steps(&mut self, planes: &PortPlanes<'_>, c: &StepCounts, emitters: &[EmitterStats]) -> Result<(), Error> {
         let l = *self.layout();
         let desc = self.head.desc;
-        let PortPlanes { occupancy, velocity, life, .. } = *planes;
-        if occupancy.len() * 8 != l.occupancy().len || velocity.len() != l.velocity().len || life.len() != l.life().len || emitters.len() != self.slots().len() {
+        let PortPlanes { occupancy, velocity, life, mass_index, .. } = *planes;
+        if occupancy.len() * 8 != l.occupancy().len || velocity.len() != l.velocity().len || life.len() != l.life().len || mass_index.len() != l.mass_index().len || emitters.len() != self.slots().len() {
             return Err(Error::BadLength);
         }
-        if desc.has_masses() || desc.identity_planes().any() {
+        if desc.identity_planes().any() {
             return Err(Error::NotEnabled);
         }
+        let classes = self.head.masses as usize;
         let obstacle: &[u64] = self.plane(l.obstacle());
         let padding = match l.n[0] % 64 {
             0 => 0,
@@ -307,6 +358,9 @@ impl World {
                 let x = (i % l.row_words) * 64 + bits.trailing_zeros() as usize;
                 bits &= bits - 1;
                 let cell = (i / l.row_words) * l.n[0] + x;
+                if mass_index.get(cell).is_some_and(|&m| usize::from(m) >= classes) {
+                    return Err(Error::ImageInvalid);
+                }
                 for k in 0..dim {
                     let at = cell * dim + k;
                     let q = if wide { i32::from(i16::from_ne_bytes([velocity[2 * at], velocity[2 * at + 1]])) } else { i32::from(velocity[at] as i8) };
@@ -329,6 +383,7 @@ impl World {
         for (to, from) in p.life.iter_mut().zip(life.chunks_exact(2)) {
             *to = u16::from_ne_bytes([from[0], from[1]]);
         }
+        p.mass_index.copy_from_slice(mass_index);
         // The step's summaries of empty rows and words (M3): "may hold a
         // particle" everywhere, so that the next step sweeps what came in.
         p.rows.fill(1);
