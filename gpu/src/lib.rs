@@ -16,11 +16,11 @@
 //! (M5.1b), collisions (M5.2 and M5.2b, any restitution), both drift rules
 //! (M5.3), reflection off walls and obstacles (M5.4, M7), the exact-fast
 //! assignment (M5.6), contacts (M5.7), energy-neutral rounding (M1b), exits
-//! through open faces, emitters and lifetimes (M6): the paper's
-//! aggregation, cluster and smoke scenes, the smoke with flow drag and the
-//! benchmark's gas. A description that needs any other part is refused when
-//! the world is made, as a CPU build without that part refuses it
-//! ([`mpca::Error::FeatureDisabled`]).
+//! through open faces, emitters and lifetimes (M6), ids, ages and tags
+//! (M6b): the paper's aggregation, cluster and smoke scenes, the smoke with
+//! flow drag and the benchmark's gas. A description that needs any other
+//! part is refused when the world is made, as a CPU build without that part
+//! refuses it ([`mpca::Error::FeatureDisabled`]).
 //!
 //! ```
 //! use mpca::{Description, WorldBox};
@@ -46,7 +46,7 @@ mod export;
 
 pub use export::Exports;
 use mpca::port::{DragConstants, PortPlanes, StepConstants, StepCounts, VortexConstants};
-use mpca::{Boundary, Collisions, Description, Drift, Identity, Method, Quantization, World, WorldBox};
+use mpca::{Boundary, Collisions, Description, Drift, Method, Quantization, World, WorldBox};
 use wgpu::util::DeviceExt;
 
 /// Why a GPU world could not be made or stepped.
@@ -132,10 +132,9 @@ impl Gpu {
 
 /// Why this backend cannot run a description: `None` where it can.
 pub fn unsupported(d: &Description) -> Option<&'static str> {
-    let checks: [(bool, &'static str); 3] = [
+    let checks: [(bool, &'static str); 2] = [
         (d.dim == 2, "3D worlds"),
         (d.method == Method::ExactFast, "an assignment other than exact-fast"),
-        (d.identity == Identity::NONE, "ids, ages and tags"),
     ];
     checks.iter().find(|(ok, _)| !ok).map(|(_, what)| *what)
 }
@@ -173,8 +172,10 @@ fn tables(moves: &[u16; 256]) -> Vec<u32> {
 /// a saturated clamp energy; the blocks processed in the last step; the
 /// number of the step the world takes next (low, high); pairs of the
 /// particles emitted, the emitters' shortfall and the particles whose
-/// lifetime ended.
-const COUNTERS: usize = 21;
+/// lifetime ended; the last id given (M6b), which a sync does not clear.
+const COUNTERS: usize = 22;
+/// Where the last id given lies in the counters.
+const IDS_GIVEN: usize = 21;
 /// Words an emitter takes in the shader's emitter table.
 const EMITTER: usize = 16;
 /// The counters a sync takes into the CPU copy and clears: all but the
@@ -215,9 +216,12 @@ pub struct GpuWorld {
     /// The obstacle cells and their surface entries (M7), as the world had
     /// them when made or loaded.
     obstacles: [wgpu::Buffer; 2],
-    /// The mass indices (M9), 16 bits a cell, where the world has masses
-    /// (a word otherwise), and the classes they stand for.
+    /// The mass indices (M9) and tags (M6b), 16 bits a cell, where the
+    /// world has either (a word otherwise), and the classes the indices
+    /// stand for.
     mass: [wgpu::Buffer; 2],
+    /// M6b's ids and ages, two words a cell, where the world keeps either.
+    ident: [wgpu::Buffer; 2],
     classes: wgpu::Buffer,
     counters: wgpu::Buffer,
     /// `groups[i]` reads pair member `i` and writes the other.
@@ -244,13 +248,14 @@ impl GpuWorld {
         let desc = *host.description();
         let (nx, ny) = (desc.size[0], desc.size[1]);
         let p = host.port_planes();
-        let (occupancy, velocity, life, mass) = (bytemuck::cast_slice::<u64, u8>(p.occupancy).to_vec(), p.velocity.to_vec(), p.life.to_vec(), widened(p.mass_index));
+        let (occupancy, velocity, life, mass, ident) = (bytemuck::cast_slice::<u64, u8>(p.occupancy).to_vec(), p.velocity.to_vec(), p.life.to_vec(), carried(&p), identities(&p));
         let storage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
         let buffer = |label: &str, bytes: &[u8]| device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents: &padded(bytes), usage: storage });
         let occupancy = [buffer("occupancy 0", &occupancy), buffer("occupancy 1", &occupancy)];
         let velocity = [buffer("velocity 0", &velocity), buffer("velocity 1", &velocity)];
         let life = [buffer("life 0", &life), buffer("life 1", &life)];
         let mass = [buffer("mass index 0", &mass), buffer("mass index 1", &mass)];
+        let ident = [buffer("ids and ages 0", &ident), buffer("ids and ages 1", &ident)];
         let classes = buffer("classes", bytemuck::cast_slice(&class_table(&host)));
         let f = host.port_fields();
         let fields = [buffer("force field", f.force), buffer("potential", f.potential), buffer("wind", f.wind)];
@@ -281,7 +286,7 @@ impl GpuWorld {
             let pipeline = pipeline_of("emit");
             let layout = pipeline.get_bind_group_layout(0);
             let group = |member: usize| {
-                let entries = [(0, &params), (6, &counters), (7, &occupancy[member]), (8, &velocity[member]), (9, &emitters), (10, &emitter_stats), (13, &life[member]), (17, &obstacles[0]), (22, &mass[member])];
+                let entries = [(0, &params), (6, &counters), (7, &occupancy[member]), (8, &velocity[member]), (9, &emitters), (10, &emitter_stats), (13, &life[member]), (17, &obstacles[0]), (22, &mass[member]), (25, &ident[member])];
                 let entries: Vec<wgpu::BindGroupEntry<'_>> = entries.iter().map(|&(binding, b)| wgpu::BindGroupEntry { binding, resource: b.as_entire_binding() }).collect();
                 device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("emit"), layout: &layout, entries: &entries })
             };
@@ -295,7 +300,7 @@ impl GpuWorld {
         let layout = pipeline.get_bind_group_layout(0);
         let group = |from: usize| {
             let to = 1 - from;
-            let entries = [(0, &params), (1, &tables), (2, &occupancy[from]), (3, &velocity[from]), (4, &occupancy[to]), (5, &velocity[to]), (6, &counters), (11, &life[from]), (12, &life[to]), (14, &fields[0]), (15, &fields[1]), (16, &fields[2]), (17, &obstacles[0]), (18, &obstacles[1]), (19, &classes), (20, &mass[from]), (21, &mass[to])];
+            let entries = [(0, &params), (1, &tables), (2, &occupancy[from]), (3, &velocity[from]), (4, &occupancy[to]), (5, &velocity[to]), (6, &counters), (11, &life[from]), (12, &life[to]), (14, &fields[0]), (15, &fields[1]), (16, &fields[2]), (17, &obstacles[0]), (18, &obstacles[1]), (19, &classes), (20, &mass[from]), (21, &mass[to]), (23, &ident[from]), (24, &ident[to])];
             let entries: Vec<wgpu::BindGroupEntry<'_>> = entries.iter().map(|&(binding, b)| wgpu::BindGroupEntry { binding, resource: b.as_entire_binding() }).collect();
             device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("step"), layout: &layout, entries: &entries })
         };
@@ -319,6 +324,7 @@ impl GpuWorld {
             fields,
             obstacles,
             mass,
+            ident,
             classes,
             counters,
             groups,
@@ -352,7 +358,8 @@ impl GpuWorld {
         queue.write_buffer(&self.occupancy[self.current], 0, bytemuck::cast_slice(p.occupancy));
         queue.write_buffer(&self.velocity[self.current], 0, &padded(p.velocity));
         queue.write_buffer(&self.life[self.current], 0, &padded(p.life));
-        queue.write_buffer(&self.mass[self.current], 0, &padded(&widened(p.mass_index)));
+        queue.write_buffer(&self.mass[self.current], 0, &padded(&carried(&p)));
+        queue.write_buffer(&self.ident[self.current], 0, &padded(&identities(&p)));
         queue.write_buffer(&self.classes, 0, bytemuck::cast_slice(&class_table(&host)));
         let f = host.port_fields();
         for (buffer, plane) in self.fields.iter().zip([f.force, f.potential, f.wind]) {
@@ -417,6 +424,7 @@ impl GpuWorld {
             let mut velocity = self.gpu.read(&self.velocity[self.current]);
             let mut life = self.gpu.read(&self.life[self.current]);
             let mass = self.gpu.read(&self.mass[self.current]);
+            let ident = self.gpu.read(&self.ident[self.current]);
             let counters: Vec<u32> = bytemuck::cast_slice(&self.gpu.read(&self.counters)).to_vec();
             let stats: Vec<u64> = bytemuck::cast_slice::<u8, u32>(&self.gpu.read(&self.emitter_stats)).chunks_exact(2).map(|w| u64::from(w[0]) | u64::from(w[1]) << 32).collect();
             let emitters = emitter_count(&self.host);
@@ -425,8 +433,12 @@ impl GpuWorld {
             let planes = self.host.port_planes();
             velocity.truncate(planes.velocity.len());
             life.truncate(planes.life.len());
-            // 16 bits a cell on the GPU, a byte in the world.
+            // 16 bits a cell on the GPU, a byte each in the world; ids and
+            // ages interleaved on the GPU.
             let mass_index: Vec<u8> = mass.chunks_exact(2).take(planes.mass_index.len()).map(|h| h[0]).collect();
+            let tag: Vec<u8> = mass.chunks_exact(2).take(planes.tag.len()).map(|h| h[1]).collect();
+            let id: Vec<u8> = ident.chunks_exact(8).take(planes.id.len() / 4).flat_map(|w| [w[0], w[1], w[2], w[3]]).collect();
+            let age: Vec<u8> = ident.chunks_exact(8).take(planes.age.len() / 4).flat_map(|w| [w[4], w[5], w[6], w[7]]).collect();
             let row_words = planes.row_words;
             let wide = |i: usize| u64::from(counters[i]) | u64::from(counters[i + 1]) << 32;
             if wide(13) != self.host.stats().step.wrapping_add(self.pending) {
@@ -443,8 +455,10 @@ impl GpuWorld {
                 emitted: wide(EMITTED),
                 shortfall: wide(EMITTED + 2),
                 expired: wide(EMITTED + 4),
+                ids_given: counters[IDS_GIVEN],
             };
-            self.host.port_finish_steps(&PortPlanes { occupancy: &occupancy, row_words, velocity: &velocity, life: &life, mass_index: &mass_index }, &counts, &emitted)?;
+            let planes = PortPlanes { occupancy: &occupancy, row_words, velocity: &velocity, life: &life, mass_index: &mass_index, id: &id, age: &age, tag: &tag };
+            self.host.port_finish_steps(&planes, &counts, &emitted)?;
             // Counted into the CPU copy: the GPU's start again from zero.
             self.gpu.queue.write_buffer(&self.counters, 0, &[0u8; 4 * COUNTED]);
             self.gpu.queue.write_buffer(&self.counters, 4 * EMITTED as u64, &[0u8; 24]);
@@ -477,10 +491,21 @@ fn surface_bytes(host: &World) -> Vec<u8> {
     bytemuck::cast_slice(&table).to_vec()
 }
 
-/// A plane of a byte a cell widened to 16 bits a cell, as the shader keeps
-/// mass indices (two cells a word: rows of an even width start on a word).
-fn widened(bytes: &[u8]) -> Vec<u8> {
-    bytes.iter().flat_map(|&b| [b, 0]).collect()
+/// What the shader keeps of a world's mass indices and tags: 16 bits a
+/// cell (two cells a word: rows of an even width start on a word), the
+/// index in the low byte and the tag in the high; empty where the world
+/// has neither.
+fn carried(p: &PortPlanes<'_>) -> Vec<u8> {
+    let cells = p.mass_index.len().max(p.tag.len());
+    (0..cells).flat_map(|i| [p.mass_index.get(i).copied().unwrap_or(0), p.tag.get(i).copied().unwrap_or(0)]).collect()
+}
+
+/// What the shader keeps of a world's ids and ages: two words a cell (id,
+/// age); empty where the world keeps neither.
+fn identities(p: &PortPlanes<'_>) -> Vec<u8> {
+    let cells = p.id.len().max(p.age.len()) / 4;
+    let word = |plane: &[u8], i: usize| plane.get(4 * i..4 * i + 4).map_or([0; 4], |w| [w[0], w[1], w[2], w[3]]);
+    (0..cells).flat_map(|i| [word(p.id, i), word(p.age, i)].concat()).collect()
 }
 
 /// The shader's class table (`step2d.wgsl`): for each of the 256 mass
@@ -506,7 +531,7 @@ fn emitter_table(host: &World, capacity: usize) -> Vec<u32> {
     let mut table = vec![0u32; EMITTER * capacity];
     for (i, entry) in table.chunks_exact_mut(EMITTER).enumerate() {
         let Some(e) = host.port_emitter(i) else { break };
-        entry[..12].copy_from_slice(&[e.min[0], e.min[1], e.max[0], e.max[1], e.whole as u32, (e.whole >> 32) as u32, e.threshold, e.velocity[0] as u32, e.velocity[1] as u32, e.radius as u32, e.lifetime, u32::from(e.mass_index)]);
+        entry[..13].copy_from_slice(&[e.min[0], e.min[1], e.max[0], e.max[1], e.whole as u32, (e.whole >> 32) as u32, e.threshold, e.velocity[0] as u32, e.velocity[1] as u32, e.radius as u32, e.lifetime, u32::from(e.mass_index), u32::from(e.tag)]);
     }
     table
 }
@@ -517,11 +542,12 @@ fn counters_of(host: &World) -> [u32; COUNTERS] {
     let mut counters = [0u32; COUNTERS];
     let step = host.stats().step;
     (counters[13], counters[14]) = (step as u32, (step >> 32) as u32);
+    counters[IDS_GIVEN] = host.port_ids_given();
     counters
 }
 
 /// The shader's parameters (`step2d.wgsl`).
-const PARAMS: usize = 53;
+const PARAMS: usize = 54;
 
 /// A face as the shader reads it: 0 periodic, 1 wall, 2 open.
 fn face(b: Boundary) -> u32 {
@@ -598,5 +624,6 @@ fn params(c: &StepConstants, d: &Description, d_emitters: u32, surfaces: u32) ->
         on(d.obstacles),
         on(d.energy_neutral),
         on(d.per_particle_mass),
+        d.identity.bits(),
     ]
 }

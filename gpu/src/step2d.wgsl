@@ -25,7 +25,8 @@
 // top(Γ'') (g, e), 43 drag (M5.1b), 44 its weight C (Q16), 45-46 the
 // uniform wind U (fine units), 47 the flow holds the wind plane, 48 the
 // flow holds the vortex, 49 S (quanta to a unit speed), 40 the surface
-// entries, 50 obstacles, 51 energy-neutral rounding (M1b), 52 masses.
+// entries, 50 obstacles, 51 energy-neutral rounding (M1b), 52 masses, 53
+// M6b's planes.
 @group(0) @binding(0) var<storage, read> params: array<u32>;
 // tables: 0..256 M5.3 move limits; 256..2304 the turns of M5.2 (cos, sin
 // as i32); 2304..3600 per 2D key its assignments (start | count << 16,
@@ -40,14 +41,15 @@
 // saturated; 12 blocks processed in the last step; 13-14 the number of the
 // step the world takes next, which `end_step` advances; pairs of the
 // particles emitted (15), the emitters' shortfall (17) and the particles
-// whose lifetime ended (19).
+// whose lifetime ended (19); 21 the last id given (M6b), which the
+// emitters count up.
 @group(0) @binding(6) var<storage, read_write> counters: array<atomic<u32>>;
 // The emitters' pass (`emit`) writes the planes the step then reads.
 @group(0) @binding(7) var<storage, read_write> occ_emit: array<u32>;
 @group(0) @binding(8) var<storage, read_write> vel_emit: array<u32>;
 // Per emitter (M6), 16 words: min x, min y, max x, max y, the rate's whole
 // part (64 bits), its 24-bit threshold, velocity x, y and spread (fine
-// units), the lifetime and the mass index of its particles.
+// units), the lifetime, the mass index and the tag of its particles.
 @group(0) @binding(9) var<storage, read> emitters: array<u32>;
 // Per emitter, 4 words: requested, delivered (64-bit pairs).
 @group(0) @binding(10) var<storage, read_write> emitter_stats: array<u32>;
@@ -74,12 +76,18 @@
 // vortex force's top(Γ') (g, e). The world's one class in each entry
 // where it has one mass.
 @group(0) @binding(19) var<storage, read> classes: array<u32>;
-// Each particle's mass index, two cells a word (16 bits each), where the
-// world has masses (params[52]): what the step reads, what it writes, and
-// what the emitters write.
+// What a particle carries in bytes, 16 bits a cell (two cells a word):
+// its mass index (low byte, where the world has masses, params[52]) and
+// its tag (high byte, M6b), where the world has either: what the step
+// reads, what it writes, and what the emitters write.
 @group(0) @binding(20) var<storage, read> mass_in: array<u32>;
 @group(0) @binding(21) var<storage, read_write> mass_out: array<u32>;
 @group(0) @binding(22) var<storage, read_write> mass_emit: array<u32>;
+// M6b's ids and ages, two words a cell (id, age), where the world keeps
+// either (params[53]: 1 ids, 2 ages, 4 tags): read, written, emitted.
+@group(0) @binding(23) var<storage, read> ident_in: array<u32>;
+@group(0) @binding(24) var<storage, read_write> ident_out: array<u32>;
+@group(0) @binding(25) var<storage, read_write> ident_emit: array<u32>;
 
 const TURNS_AT: u32 = 256u;
 const KEYS_AT: u32 = 2304u;
@@ -400,6 +408,10 @@ struct Block {
     life: array<u32, 4>,
     // Mass indices (M9), where the world has masses; 0 otherwise.
     mass: array<u32, 4>,
+    // M6b's tags, ids and ages, where the world keeps them.
+    tag: array<u32, 4>,
+    id: array<u32, 4>,
+    age: array<u32, 4>,
 }
 
 // Where a block lies (M3, M4): its cells' raw coordinates (one beyond a
@@ -1192,6 +1204,11 @@ fn step_2d(@builtin(global_invocation_id) id: vec3<u32>) {
     var out_vel: array<array<u32, 32>, 2>;
     var out_life: array<array<u32, 16>, 2>;
     var out_mass: array<array<u32, 16>, 2>;
+    var out_ident: array<array<u32, 64>, 2>;
+    for (var i = 0u; i < 64u; i++) {
+        out_ident[0][i] = 0u;
+        out_ident[1][i] = 0u;
+    }
     for (var i = 0u; i < 32u; i++) {
         out_vel[0][i] = 0u;
         out_vel[1][i] = 0u;
@@ -1238,6 +1255,9 @@ fn step_2d(@builtin(global_invocation_id) id: vec3<u32>) {
             site.normal[c] = vec2<i32>(0, 0);
             b.life[c] = 0u;
             b.mass[c] = 0u;
+            b.tag[c] = 0u;
+            b.id[c] = 0u;
+            b.age[c] = 0u;
             if col.kind == 0u && row.kind == 0u {
                 if is_obstacle(col.at, row.at) {
                     site.blocked |= 1u << c;
@@ -1249,8 +1269,14 @@ fn step_2d(@builtin(global_invocation_id) id: vec3<u32>) {
                     if params[36] != 0u {
                         b.life[c] = life_in[i >> 1u] >> (16u * (i & 1u)) & 0xffffu;
                     }
-                    if masses_on() {
-                        b.mass[c] = mass_in[i >> 1u] >> (16u * (i & 1u)) & 0xffu;
+                    if masses_on() || (params[53] & 4u) != 0u {
+                        let carried = mass_in[i >> 1u] >> (16u * (i & 1u));
+                        b.mass[c] = select(0u, carried & 0xffu, masses_on());
+                        b.tag[c] = carried >> 8u & 0xffu;
+                    }
+                    if (params[53] & 3u) != 0u {
+                        b.id[c] = ident_in[2u * i];
+                        b.age[c] = ident_in[2u * i + 1u];
                     }
                 }
             } else if col.kind == 1u || row.kind == 1u {
@@ -1306,7 +1332,11 @@ fn step_2d(@builtin(global_invocation_id) id: vec3<u32>) {
                 out_vel[row][(x - lo) >> 1u] |= byte_pair << (16u * (x & 1u));
             }
             out_life[row][(x - lo) >> 1u] |= (max(b.life[c], 1u) - 1u) << (16u * (x & 1u));
-            out_mass[row][(x - lo) >> 1u] |= b.mass[c] << (16u * (x & 1u));
+            out_mass[row][(x - lo) >> 1u] |= (b.mass[c] | b.tag[c] << 8u) << (16u * (x & 1u));
+            // M6b: the id and the tag go with the particle, its age counts
+            // the step (saturating).
+            out_ident[row][2u * (x - lo)] = b.id[c];
+            out_ident[row][2u * (x - lo) + 1u] = select(b.age[c] + 1u, b.age[c], b.age[c] == 0xffffffffu);
         }
         // Counted by the invocation that owns the block's first cell inside.
         let owner = u32(max(x0, 0));
@@ -1338,8 +1368,14 @@ fn step_2d(@builtin(global_invocation_id) id: vec3<u32>) {
             if params[36] != 0u {
                 life_out[first + k] = out_life[row][k];
             }
-            if masses_on() {
+            if masses_on() || (params[53] & 4u) != 0u {
                 mass_out[first + k] = out_mass[row][k];
+            }
+        }
+        if (params[53] & 3u) != 0u {
+            let base = 2u * (rows[row].at * nx + lo);
+            for (var k = 0u; k < 2u * (hi - lo); k++) {
+                ident_out[base + k] = out_ident[row][k];
             }
         }
     }
@@ -1399,7 +1435,11 @@ fn emit() {
                 free += select(1u - (occ_emit[y * row_u32 + (x >> 5u)] >> (x & 31u) & 1u), 0u, is_obstacle(x, y));
             }
         }
-        let placing = select(free, wanted.x, wanted.y == 0u && wanted.x < free);
+        var placing = select(free, wanted.x, wanted.y == 0u && wanted.x < free);
+        // M6b: no more particles than ids are left; the rest falls short.
+        if (params[53] & 1u) != 0u {
+            placing = min(placing, 0xffffffffu - atomicLoad(&counters[21]));
+        }
         var need = placing;
         var left = free;
         for (var y = emitters[e + 1u]; y < emitters[e + 3u]; y++) {
@@ -1448,8 +1488,18 @@ fn emit() {
                 if params[36] != 0u {
                     life_emit[cell >> 1u] = (life_emit[cell >> 1u] & ~(0xffffu << half)) | (emitters[e + 10u] & 0xffffu) << half;
                 }
-                if masses_on() {
-                    mass_emit[cell >> 1u] = (mass_emit[cell >> 1u] & ~(0xffffu << half)) | (emitters[e + 11u] & 0xffu) << half;
+                if masses_on() || (params[53] & 4u) != 0u {
+                    let carried = select(0u, emitters[e + 11u] & 0xffu, masses_on()) | (emitters[e + 12u] & 0xffu) << 8u;
+                    mass_emit[cell >> 1u] = (mass_emit[cell >> 1u] & ~(0xffffu << half)) | carried << half;
+                }
+                // M6b: the next id, age 0.
+                if (params[53] & 1u) != 0u {
+                    let id = atomicLoad(&counters[21]) + 1u;
+                    atomicStore(&counters[21], id);
+                    ident_emit[2u * cell] = id;
+                }
+                if (params[53] & 2u) != 0u {
+                    ident_emit[2u * cell + 1u] = 0u;
                 }
             }
         }

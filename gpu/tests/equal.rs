@@ -186,12 +186,12 @@ fn planes_that_are_not_a_world_are_refused_and_change_nothing() {
     lost[first] &= lost[first] - 1;
     cases.push((lost.clone(), velocity.clone(), &[], mpca::Error::ImageInvalid));
     for (o, v, life, want) in cases {
-        let planes = PortPlanes { occupancy: &o, row_words, velocity: &v, life, mass_index: &[] };
+        let planes = PortPlanes { occupancy: &o, row_words, velocity: &v, life, mass_index: &[], id: &[], age: &[], tag: &[] };
         assert_eq!(w.port_finish_steps(&planes, &one, &[]), Err(want));
         assert_eq!((w.state_hash(), w.stats()), (hash, stats));
     }
     // One particle fewer is what one exit (or one expiry) leaves.
-    let planes = PortPlanes { occupancy: &lost, row_words, velocity: &velocity, life: &[], mass_index: &[] };
+    let planes = PortPlanes { occupancy: &lost, row_words, velocity: &velocity, life: &[], mass_index: &[], id: &[], age: &[], tag: &[] };
     w.port_finish_steps(&planes, &StepCounts { steps: 1, exited: 1, ..StepCounts::default() }, &[]).unwrap();
     assert_eq!(w.stats().particles, stats.particles - 1);
     // A mass index the world has no class for.
@@ -202,17 +202,23 @@ fn planes_that_are_not_a_world_are_refused_and_change_nothing() {
     };
     let cell = o[0].trailing_zeros() as usize;
     m[cell] = 1;
-    let planes = PortPlanes { occupancy: &o, row_words: 1, velocity: &v, life: &[], mass_index: &m };
+    let planes = PortPlanes { occupancy: &o, row_words: 1, velocity: &v, life: &[], mass_index: &m, id: &[], age: &[], tag: &[] };
     assert_eq!(heavy.port_finish_steps(&planes, &one, &[]), Err(mpca::Error::ImageInvalid));
-    // A world whose particles carry ids: the planes cannot say where they
-    // went.
-    let mut named = gas(8, 8, 0.4, 3, |d| d.identity = mpca::Identity::IDS);
-    let (o, v) = {
+    // Ids: one never given, and fewer ids given than before.
+    let mut named = gas(8, 8, 0.4, 3, |d| d.identity = mpca::Identity::ALL);
+    let (o, v, mut id, age, tag) = {
         let p = named.port_planes();
-        (p.occupancy.to_vec(), p.velocity.to_vec())
+        (p.occupancy.to_vec(), p.velocity.to_vec(), p.id.to_vec(), p.age.to_vec(), p.tag.to_vec())
     };
-    let planes = PortPlanes { occupancy: &o, row_words: 1, velocity: &v, life: &[], mass_index: &[] };
-    assert_eq!(named.port_finish_steps(&planes, &one, &[]), Err(mpca::Error::NotEnabled));
+    let given = named.port_ids_given();
+    let counts = StepCounts { steps: 1, ids_given: given, ..StepCounts::default() };
+    let fewer = StepCounts { ids_given: given - 1, ..counts };
+    let planes = PortPlanes { occupancy: &o, row_words: 1, velocity: &v, life: &[], mass_index: &[], id: &id, age: &age, tag: &tag };
+    assert_eq!(named.port_finish_steps(&planes, &fewer, &[]), Err(mpca::Error::ImageInvalid));
+    let cell = o[0].trailing_zeros() as usize;
+    id[4 * cell..4 * cell + 4].copy_from_slice(&(given + 1).to_ne_bytes());
+    let planes = PortPlanes { occupancy: &o, row_words: 1, velocity: &v, life: &[], mass_index: &[], id: &id, age: &age, tag: &tag };
+    assert_eq!(named.port_finish_steps(&planes, &counts, &[]), Err(mpca::Error::ImageInvalid));
 }
 
 #[test]
@@ -545,6 +551,37 @@ fn masses_step_as_on_the_cpu() {
         w.set_force_field(&force).unwrap();
         w.set_potential(&potential).unwrap();
         w.add_emitter(mpca::Emitter { min: [5, 20, 0], max: [12, 26, 0], rate: 1.3, velocity: [0.1, -0.2, 0.0], spread: 0.1, mass: 2.5, lifetime: 0 }).unwrap();
+        same_worlds(&mut w, 30, 1);
+    }
+}
+
+#[test]
+fn ids_ages_and_tags_step_as_on_the_cpu() {
+    // M6b: particles added with ids (and tags set on some), two emitters
+    // with tags of their own, lifetimes and an open face, so that ids are
+    // given, carried, aged and removed; each plane alone and all three, at
+    // both widths.
+    for (identity, quantization) in [(mpca::Identity::ALL, mpca::Quantization::Bits8), (mpca::Identity::IDS, mpca::Quantization::Bits16), (mpca::Identity::AGES, mpca::Quantization::Bits8), (mpca::Identity::TAGS, mpca::Quantization::Bits16)] {
+        let mut w = gas(34, 24, 0.3, 111, |d| {
+            d.identity = identity;
+            d.quantization = quantization;
+            d.boundary[0] = [mpca::Boundary::Open, mpca::Boundary::Wall];
+            d.lifetimes = true;
+            d.emitter_capacity = 2;
+            d.per_particle_mass = identity == mpca::Identity::ALL;
+        });
+        if identity.contains(mpca::Identity::TAGS) {
+            for (i, p) in w.particles().collect::<Vec<_>>().into_iter().enumerate().step_by(3) {
+                w.set_tag(p.pos, (i % 250) as u8 + 1).unwrap();
+            }
+        }
+        let emitter = |min: [u32; 3], max: [u32; 3], lifetime: u32| mpca::Emitter { min, max, rate: 2.2, velocity: [0.3, 0.1, 0.0], spread: 0.3, mass: 1.0, lifetime };
+        let a = w.add_emitter(emitter([2, 2, 0], [10, 8, 0], 9)).unwrap();
+        let b = w.add_emitter(emitter([20, 14, 0], [30, 20, 0], 0)).unwrap();
+        if identity.contains(mpca::Identity::TAGS) {
+            w.set_emitter_tag(a, 7).unwrap();
+            w.set_emitter_tag(b, 200).unwrap();
+        }
         same_worlds(&mut w, 30, 1);
     }
 }

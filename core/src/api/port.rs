@@ -121,6 +121,8 @@ pub struct EmitterConstants {
     pub lifetime: u32,
     /// The mass index its particles get (M9).
     pub mass_index: u8,
+    /// The tag its particles get (M6b).
+    pub tag: u8,
 }
 
 /// What steps run elsewhere counted (the fields of [`crate::Stats`] of the
@@ -147,6 +149,9 @@ pub struct StepCounts {
     pub shortfall: u64,
     /// In the last of those steps.
     pub blocks_processed: u64,
+    /// The last id given after those steps (M6b; the world's own where it
+    /// keeps no ids).
+    pub ids_given: u32,
 }
 
 /// A world's occupancy and velocity planes, as the step reads them.
@@ -166,6 +171,13 @@ pub struct PortPlanes<'a> {
     /// Each particle's mass class (M9), a byte a cell; empty in a world
     /// of one mass.
     pub mass_index: &'a [u8],
+    /// M6b's ids (four bytes a cell), ages (four) and tags (one), each
+    /// empty where the world keeps none.
+    pub id: &'a [u8],
+    /// See `id`.
+    pub age: &'a [u8],
+    /// See `id`.
+    pub tag: &'a [u8],
 }
 
 /// A mass class as a step reads it (M1c).
@@ -255,6 +267,7 @@ impl World {
             radius: to_fine(e.spread, scale),
             lifetime: e.lifetime,
             mass_index: slot.mass_index(),
+            tag: slot.tag(),
         })
     }
 
@@ -267,6 +280,9 @@ impl World {
             velocity: self.plane_bytes(l.velocity()),
             life: self.plane_bytes(l.life()),
             mass_index: self.plane_bytes(l.mass_index()),
+            id: self.identity_plane(0),
+            age: self.identity_plane(1),
+            tag: self.identity_plane(2),
         }
     }
 
@@ -291,6 +307,26 @@ impl World {
             push: class.push.to_bits(),
             swirl: swirl.map(|_| (class.swirl.g, class.swirl.e)),
         }
+    }
+
+    /// M6b's plane `which` (0 ids, 1 ages, 2 tags) as bytes; empty in a
+    /// build without them.
+    fn identity_plane(&self, which: usize) -> &[u8] {
+        #[cfg(feature = "identity")]
+        {
+            let l = self.layout();
+            self.plane_bytes([l.id(), l.age(), l.tag()][which])
+        }
+        #[cfg(not(feature = "identity"))]
+        {
+            let _ = which;
+            &[]
+        }
+    }
+
+    /// The ids given so far (M6b): the last one given.
+    pub fn port_ids_given(&self) -> u32 {
+        self.head.ids_given
     }
 
     /// The obstacle cells (M7), one bit a cell laid out as the occupancy
@@ -322,21 +358,23 @@ impl World {
     /// emitter).
     ///
     /// Refused, with the world unchanged: planes of the wrong length
-    /// (`BadLength`); a world whose particles carry ids, ages or tags
-    /// (`NotEnabled`, since the planes do not say where those went); a
-    /// mass index the world has no class for, a bit set beyond a row's end, a
+    /// (`BadLength`); fewer ids given than before, an id of a particle
+    /// that was never given, a mass index the world has no class for, a bit set beyond a row's end, a
     /// particle on an obstacle, a stored component beyond the storage's
     /// range, or a particle count other than the world's with the emitted
     /// and without the exits and expiries (`ImageInvalid`).
     pub fn port_finish_steps(&mut self, planes: &PortPlanes<'_>, c: &StepCounts, emitters: &[EmitterStats]) -> Result<(), Error> {
         let l = *self.layout();
         let desc = self.head.desc;
-        let PortPlanes { occupancy, velocity, life, mass_index, .. } = *planes;
-        if occupancy.len() * 8 != l.occupancy().len || velocity.len() != l.velocity().len || life.len() != l.life().len || mass_index.len() != l.mass_index().len || emitters.len() != self.slots().len() {
+        let PortPlanes { occupancy, velocity, life, mass_index, id, age, tag, .. } = *planes;
+        let own = self.port_planes();
+        let lengths = [(occupancy.len() * 8, own.occupancy.len() * 8), (velocity.len(), own.velocity.len()), (life.len(), own.life.len()), (mass_index.len(), own.mass_index.len()), (id.len(), own.id.len()), (age.len(), own.age.len()), (tag.len(), own.tag.len()), (emitters.len(), self.slots().len())];
+        if lengths.iter().any(|(a, b)| a != b) {
             return Err(Error::BadLength);
         }
-        if desc.identity_planes().any() {
-            return Err(Error::NotEnabled);
+        // The last id given only grows (M6b).
+        if c.ids_given < self.head.ids_given {
+            return Err(Error::ImageInvalid);
         }
         let classes = self.head.masses as usize;
         let obstacle: &[u64] = self.plane(l.obstacle());
@@ -361,6 +399,9 @@ impl World {
                 if mass_index.get(cell).is_some_and(|&m| usize::from(m) >= classes) {
                     return Err(Error::ImageInvalid);
                 }
+                if id.len() >= 4 * (cell + 1) && !(1..=c.ids_given).contains(&u32::from_ne_bytes([id[4 * cell], id[4 * cell + 1], id[4 * cell + 2], id[4 * cell + 3]])) {
+                    return Err(Error::ImageInvalid);
+                }
                 for k in 0..dim {
                     let at = cell * dim + k;
                     let q = if wide { i32::from(i16::from_ne_bytes([velocity[2 * at], velocity[2 * at + 1]])) } else { i32::from(velocity[at] as i8) };
@@ -373,7 +414,8 @@ impl World {
         if Some(count) != self.head.counters.particles.checked_add(c.emitted).and_then(|n| n.checked_sub(c.exited)).and_then(|n| n.checked_sub(c.expired)) {
             return Err(Error::ImageInvalid);
         }
-        let (_, p) = self.planes::<u8>();
+        let (head, p) = self.planes::<u8>();
+        head.ids_given = c.ids_given;
         for (slot, more) in p.emitters.iter_mut().zip(emitters) {
             slot.stats.requested = slot.stats.requested.saturating_add(more.requested);
             slot.stats.delivered = slot.stats.delivered.saturating_add(more.delivered);
@@ -384,6 +426,18 @@ impl World {
             *to = u16::from_ne_bytes([from[0], from[1]]);
         }
         p.mass_index.copy_from_slice(mass_index);
+        #[cfg(feature = "identity")]
+        {
+            for (to, from) in p.id.iter_mut().zip(id.chunks_exact(4)) {
+                *to = u32::from_ne_bytes([from[0], from[1], from[2], from[3]]);
+            }
+            for (to, from) in p.age.iter_mut().zip(age.chunks_exact(4)) {
+                *to = u32::from_ne_bytes([from[0], from[1], from[2], from[3]]);
+            }
+            p.tag.copy_from_slice(tag);
+        }
+        #[cfg(not(feature = "identity"))]
+        let _ = (age, tag);
         // The step's summaries of empty rows and words (M3): "may hold a
         // particle" everywhere, so that the next step sweeps what came in.
         p.rows.fill(1);
