@@ -11,16 +11,15 @@
 //! planes and the counters down into it, which checks them, and from there
 //! come the hash, the statistics and the snapshot image.
 //!
-//! This version runs the 2D rule with 8-bit or 16-bit velocities, one mass
-//! or many (M9), on any faces: every force term (M5.1) and flow drag
-//! (M5.1b), collisions (M5.2 and M5.2b, any restitution), both drift rules
-//! (M5.3), reflection off walls and obstacles (M5.4, M7), the exact-fast
-//! assignment (M5.6), contacts (M5.7), energy-neutral rounding (M1b), exits
-//! through open faces, emitters and lifetimes (M6), ids, ages and tags
-//! (M6b): the paper's aggregation, cluster and smoke scenes, the smoke with
-//! flow drag and the benchmark's gas. A description that needs any other
-//! part is refused when the world is made, as a CPU build without that part
-//! refuses it ([`mpca::Error::FeatureDisabled`]).
+//! This version runs every part of the 2D rule: both velocity widths, one
+//! mass or many (M9), every face, every force term (M5.1) and flow drag
+//! (M5.1b), both collision rules (M5.2, M5.2b), both drift rules (M5.3),
+//! reflection off walls and obstacles (M5.4, M7), every assignment method
+//! (M5.6), contacts (M5.7), energy-neutral rounding (M1b), emitters and
+//! lifetimes (M6), ids, ages and tags (M6b): the paper's aggregation,
+//! cluster and smoke scenes, the smoke with flow drag and the benchmark's
+//! gas. A 3D description is refused when the world is made, as a CPU build
+//! without `dim3` refuses it ([`mpca::Error::FeatureDisabled`]).
 //!
 //! ```
 //! use mpca::{Description, WorldBox};
@@ -46,7 +45,7 @@ mod export;
 
 pub use export::Exports;
 use mpca::port::{DragConstants, PortPlanes, StepConstants, StepCounts, VortexConstants};
-use mpca::{Boundary, Collisions, Description, Drift, Method, Quantization, World, WorldBox};
+use mpca::{Boundary, Collisions, Description, Drift, Quantization, World, WorldBox};
 use wgpu::util::DeviceExt;
 
 /// Why a GPU world could not be made or stepped.
@@ -132,9 +131,8 @@ impl Gpu {
 
 /// Why this backend cannot run a description: `None` where it can.
 pub fn unsupported(d: &Description) -> Option<&'static str> {
-    let checks: [(bool, &'static str); 2] = [
+    let checks: [(bool, &'static str); 1] = [
         (d.dim == 2, "3D worlds"),
-        (d.method == Method::ExactFast, "an assignment other than exact-fast"),
     ];
     checks.iter().find(|(ok, _)| !ok).map(|(_, what)| *what)
 }
@@ -547,7 +545,7 @@ fn counters_of(host: &World) -> [u32; COUNTERS] {
 }
 
 /// The shader's parameters (`step2d.wgsl`).
-const PARAMS: usize = 54;
+const PARAMS: usize = 55;
 
 /// A face as the shader reads it: 0 periodic, 1 wall, 2 open.
 fn face(b: Boundary) -> u32 {
@@ -625,5 +623,6 @@ fn params(c: &StepConstants, d: &Description, d_emitters: u32, surfaces: u32) ->
         on(d.energy_neutral),
         on(d.per_particle_mass),
         d.identity.bits(),
+        d.method as u32,
     ]
 }

@@ -26,7 +26,7 @@
 // uniform wind U (fine units), 47 the flow holds the wind plane, 48 the
 // flow holds the vortex, 49 S (quanta to a unit speed), 40 the surface
 // entries, 50 obstacles, 51 energy-neutral rounding (M1b), 52 masses, 53
-// M6b's planes.
+// M6b's planes, 54 M5.6's method (0 exhaustive, 1 exact-fast, 2 greedy).
 @group(0) @binding(0) var<storage, read> params: array<u32>;
 // tables: 0..256 M5.3 move limits; 256..2304 the turns of M5.2 (cos, sin
 // as i32); 2304..3600 per 2D key its assignments (start | count << 16,
@@ -1064,7 +1064,111 @@ fn desire(b: ptr<function, Block>, site: ptr<function, Site>, s: ptr<function, S
     return want;
 }
 
-// M5.6, exact-fast: the cell each particle goes to, 2 bits a cell.
+// Cells apart within a block: the axes along which a and b differ.
+fn dist(a: u32, b: u32) -> u32 {
+    return countOneBits((a ^ b) & 3u);
+}
+
+// M5.6 by exhaustive search (the paper's method): every way of giving the
+// particles (in cell order, cells[0..count]) distinct free cells, in the
+// order a depth-first search meets them (the first particle's cell
+// slowest), the cost (distance to the wanted cell, then to the current,
+// lexicographically) summed; one optimum kept by reservoir sampling, a draw
+// at each tie. The cell each particle goes to, 2 bits a particle.
+fn exhaustive(cells: array<u32, 4>, wished: array<u32, 4>, count: u32, free: u32, s: ptr<function, Stream>) -> u32 {
+    var best = 0xffffffffu;
+    var ties = 0u;
+    var kept = 0u;
+    let leaves = 1u << (2u * count);
+    for (var path = 0u; path < leaves; path++) {
+        // Particle i takes cell (path >> 2 (count - 1 - i)) & 3.
+        var used = 0u;
+        var cost = 0u;
+        var ok = true;
+        var packed = 0u;
+        for (var i = 0u; i < count; i++) {
+            let cell = path >> (2u * (count - 1u - i)) & 3u;
+            if (free >> cell & 1u) == 0u || (used >> cell & 1u) != 0u {
+                ok = false;
+                break;
+            }
+            used |= 1u << cell;
+            cost += dist(cell, wished[i]) << 8u | dist(cell, cells[i]);
+            packed |= cell << (2u * i);
+        }
+        if !ok {
+            continue;
+        }
+        if cost < best {
+            best = cost;
+            ties = 1u;
+            kept = packed;
+        } else if cost == best {
+            ties += 1u;
+            if below(s, ties) == 0u {
+                kept = packed;
+            }
+        }
+    }
+    return kept;
+}
+
+// M5.6 by greedy (the paper's 3D approximation): particles by stored
+// squared speed, fastest first (equal speeds in cell order), each to the
+// free untaken cell of least cost (32 times the distance to its wanted
+// cell plus the distance to its own), a draw among ties. 2 bits a
+// particle.
+fn greedy(b: ptr<function, Block>, cells: array<u32, 4>, wished: array<u32, 4>, count: u32, free: u32, s: ptr<function, Stream>) -> u32 {
+    var order: array<u32, 4>;
+    for (var i = 0u; i < count; i++) {
+        let q = (*b).v[cells[i]];
+        let speed = u32(q.x * q.x) + u32(q.y * q.y);
+        var slot = i;
+        while slot > 0u {
+            let p = (*b).v[cells[order[slot - 1u]]];
+            if u32(p.x * p.x) + u32(p.y * p.y) >= speed {
+                break;
+            }
+            order[slot] = order[slot - 1u];
+            slot -= 1u;
+        }
+        order[slot] = i;
+    }
+    var taken = 0u;
+    var packed = 0u;
+    for (var k = 0u; k < count; k++) {
+        let i = order[k];
+        var best = 0xffffffffu;
+        var tied: array<u32, 4>;
+        var ties = 0u;
+        for (var cell = 0u; cell < 4u; cell++) {
+            if (free >> cell & 1u) == 0u || (taken >> cell & 1u) != 0u {
+                continue;
+            }
+            let cost = 32u * dist(cell, wished[i]) + dist(cell, cells[i]);
+            if cost < best {
+                best = cost;
+                ties = 0u;
+            }
+            if cost == best {
+                tied[ties] = cell;
+                ties += 1u;
+            }
+        }
+        var pick = 0u;
+        if ties > 1u {
+            pick = below(s, ties);
+        }
+        taken |= 1u << tied[pick];
+        packed |= tied[pick] << (2u * i);
+    }
+    return packed;
+}
+
+// M5.6: the cell each particle goes to, 2 bits a cell, counting those not
+// placed in the cell they want; exact-fast by one look-up in the table of
+// every block state's optimal assignments, or by the method the
+// description chooses (params[54]).
 fn assign(b: ptr<function, Block>, blocked: u32, want: u32, s: ptr<function, Stream>, counts: ptr<function, Counts>) -> u32 {
     let occ = (*b).occ;
     if want == 0u {
@@ -1073,6 +1177,32 @@ fn assign(b: ptr<function, Block>, blocked: u32, want: u32, s: ptr<function, Str
     if (occ & (occ - 1u)) == 0u {
         let c = firstTrailingBit(occ);
         return 0xe4u ^ ((want >> (2u * c) & 3u) << (2u * c));
+    }
+    if params[54] != 1u {
+        var cells: array<u32, 4>;
+        var wished: array<u32, 4>;
+        var count = 0u;
+        for (var c = 0u; c < 4u; c++) {
+            if (occ >> c & 1u) != 0u {
+                cells[count] = c;
+                wished[count] = c ^ (want >> (2u * c) & 3u);
+                count += 1u;
+            }
+        }
+        let free = ~blocked & 15u;
+        var packed: u32;
+        if params[54] == 0u {
+            packed = exhaustive(cells, wished, count, free, s);
+        } else {
+            packed = greedy(b, cells, wished, count, free, s);
+        }
+        var targets = 0xe4u;
+        for (var i = 0u; i < count; i++) {
+            let t = packed >> (2u * i) & 3u;
+            targets = (targets & ~(3u << (2u * cells[i]))) | t << (2u * cells[i]);
+            (*counts).displaced += select(0u, 1u, t != wished[i]);
+        }
+        return targets;
     }
     var key = 0u;
     for (var c = 0u; c < 4u; c++) {

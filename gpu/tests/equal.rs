@@ -104,9 +104,9 @@ fn many_steps_between_syncs_step_as_on_the_cpu() {
 #[test]
 fn a_part_the_backend_does_not_run_is_refused() {
     let gpu = gpu();
-    let w = gas(8, 8, 0.2, 1, |d| d.method = mpca::Method::Greedy);
+    let w = WorldBox::new(&Description::new_3d(8, 8, 8)).unwrap();
     assert!(matches!(GpuWorld::new(&gpu, &w), Err(mpca_gpu::Error::World(mpca::Error::FeatureDisabled))));
-    assert_eq!(mpca_gpu::unsupported(w.description()), Some("an assignment other than exact-fast"));
+    assert_eq!(mpca_gpu::unsupported(w.description()), Some("3D worlds"));
 }
 
 /// A scene of the paper as the paper ran it, compared every `every` steps.
@@ -302,8 +302,8 @@ fn a_world_moves_between_the_cpu_and_the_gpu_through_its_image_mid_run() {
     // A GPU world runs a world of its own, then takes the CPU's image at
     // step 10 (another seed and restitution: its settings come with it),
     // runs on, and its image comes back to a fresh CPU world that runs on:
-    // all equal to the CPU's own run. Images of another size, or of a part
-    // the backend does not run, are refused and change nothing.
+    // all equal to the CPU's own run. Images of another size, or of a 3D
+    // world, are refused and change nothing.
     let gpu = gpu();
     let walls = |d: &mut Description| d.boundary[1] = [mpca::Boundary::Wall; 2];
     let mut cpu = gas(48, 40, 0.4, 31, walls);
@@ -317,7 +317,8 @@ fn a_world_moves_between_the_cpu_and_the_gpu_through_its_image_mid_run() {
     g.load(&image(&cpu)).unwrap();
     let before = g.sync().unwrap().state_hash();
     assert_eq!(before, cpu.state_hash());
-    for (other, why) in [(gas(50, 40, 0.4, 31, walls), mpca::Error::ImageMismatch), (gas(48, 40, 0.4, 31, |d| d.method = mpca::Method::Greedy), mpca::Error::FeatureDisabled)] {
+    let solid = WorldBox::new(&Description::new_3d(48, 40, 2)).unwrap();
+    for (other, why) in [(&*gas(50, 40, 0.4, 31, walls), mpca::Error::ImageMismatch), (&*solid, mpca::Error::ImageMismatch)] {
         assert!(matches!(g.load(&image(&other)), Err(mpca_gpu::Error::World(e)) if e == why));
         assert_eq!(g.sync().unwrap().state_hash(), before);
     }
@@ -582,6 +583,30 @@ fn ids_ages_and_tags_step_as_on_the_cpu() {
             w.set_emitter_tag(a, 7).unwrap();
             w.set_emitter_tag(b, 200).unwrap();
         }
+        same_worlds(&mut w, 30, 1);
+    }
+}
+
+#[test]
+fn exhaustive_and_greedy_assignments_step_as_on_the_cpu() {
+    // M5.6 by the paper's exhaustive search and by greedy, in a dense gas
+    // with walls and obstacles (blocked cells in the blocks) and gravity.
+    for method in [mpca::Method::Exhaustive, mpca::Method::Greedy] {
+        let mut w = gas_around(
+            34,
+            26,
+            0.6,
+            121,
+            |d| {
+                d.method = method;
+                d.boundary[1] = [mpca::Boundary::Wall; 2];
+                d.obstacles = true;
+                d.surface_capacity = 200;
+                d.forces.uniform = true;
+                d.gravity = [0.0, 0.01, 0.0];
+            },
+            |w| w.add_shape(mpca::Shape::Disc { centre: [17.0, 13.0], radius: 4.5 }, 0.5).unwrap(),
+        );
         same_worlds(&mut w, 30, 1);
     }
 }
