@@ -319,7 +319,7 @@ fn a_world_moves_between_the_cpu_and_the_gpu_through_its_image_mid_run() {
     assert_eq!(before, cpu.state_hash());
     let solid = WorldBox::new(&Description::new_3d(48, 40, 2)).unwrap();
     for (other, why) in [(&*gas(50, 40, 0.4, 31, walls), mpca::Error::ImageMismatch), (&*solid, mpca::Error::ImageMismatch)] {
-        assert!(matches!(g.load(&image(&other)), Err(mpca_gpu::Error::World(e)) if e == why));
+        assert!(matches!(g.load(&image(other)), Err(mpca_gpu::Error::World(e)) if e == why));
         assert_eq!(g.sync().unwrap().state_hash(), before);
     }
     g.step(15);
