@@ -92,6 +92,34 @@ pub struct Gpu {
     pub queue: wgpu::Queue,
     /// The adapter's name and driver, where this made the device.
     pub adapter: String,
+    /// The step's pipelines, compiled for the first world made on this
+    /// device and shared by every other (clones of a `Gpu` share them).
+    pipelines: std::sync::Arc<std::sync::OnceLock<Pipelines>>,
+}
+
+/// The compute pipelines of `step2d.wgsl`: the sweep, the end of a step,
+/// the emitters.
+struct Pipelines {
+    step: wgpu::ComputePipeline,
+    end: wgpu::ComputePipeline,
+    emit: wgpu::ComputePipeline,
+}
+
+impl Pipelines {
+    fn of(device: &wgpu::Device) -> Pipelines {
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some("step2d.wgsl"), source: wgpu::ShaderSource::Wgsl(include_str!("step2d.wgsl").into()) });
+        let pipeline = |entry: &str| {
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(entry),
+                layout: None,
+                module: &module,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        };
+        Pipelines { step: pipeline("step_2d"), end: pipeline("end_step"), emit: pipeline("emit") }
+    }
 }
 
 impl Gpu {
@@ -104,12 +132,12 @@ impl Gpu {
         let info = adapter.get_info();
         let descriptor = wgpu::DeviceDescriptor { label: Some("mpca"), required_limits: adapter.limits(), ..Default::default() };
         let (device, queue) = pollster::block_on(adapter.request_device(&descriptor)).map_err(|e| Error::Device(e.to_string()))?;
-        Ok(Gpu { device, queue, adapter: format!("{} ({:?}, {})", info.name, info.backend, info.driver_info) })
+        Ok(Gpu { device, queue, adapter: format!("{} ({:?}, {})", info.name, info.backend, info.driver_info), pipelines: Default::default() })
     }
 
     /// The caller's device and queue.
     pub fn from_device(device: wgpu::Device, queue: wgpu::Queue) -> Gpu {
-        Gpu { device, queue, adapter: String::from("the caller's device") }
+        Gpu { device, queue, adapter: String::from("the caller's device"), pipelines: Default::default() }
     }
 
     /// The contents of `buffer` (which needs `COPY_SRC`), read back after
@@ -263,25 +291,15 @@ impl GpuWorld {
         let counters = buffer("counters", bytemuck::cast_slice(&counters_of(&host)));
         let params = buffer("params", bytemuck::cast_slice(&params(&host.port_constants(), &desc, emitter_count(&host) as u32, surface_table(&host).len() as u32 / 4)));
         let tables = buffer("tables", bytemuck::cast_slice(&tables(mpca::port::move_table_8(desc.drift))));
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some("step2d.wgsl"), source: wgpu::ShaderSource::Wgsl(include_str!("step2d.wgsl").into()) });
-        let pipeline_of = |entry: &str| {
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(entry),
-                layout: None,
-                module: &module,
-                entry_point: Some(entry),
-                compilation_options: Default::default(),
-                cache: None,
-            })
-        };
-        let (pipeline, end) = (pipeline_of("step_2d"), pipeline_of("end_step"));
+        let shared = gpu.pipelines.get_or_init(|| Pipelines::of(device));
+        let (pipeline, end) = (shared.step.clone(), shared.end.clone());
         // Room for every emitter the world can hold: an image may bring
         // another count.
         let capacity = desc.emitter_capacity as usize;
         let emitters = buffer("emitters", bytemuck::cast_slice(&emitter_table(&host, capacity)));
         let emitter_stats = buffer("emitter stats", &vec![0u8; 16 * capacity]);
         let emit = (capacity > 0).then(|| {
-            let pipeline = pipeline_of("emit");
+            let pipeline = shared.emit.clone();
             let layout = pipeline.get_bind_group_layout(0);
             let group = |member: usize| {
                 let entries = [(0, &params), (6, &counters), (7, &occupancy[member]), (8, &velocity[member]), (9, &emitters), (10, &emitter_stats), (13, &life[member]), (17, &obstacles[0]), (22, &mass[member]), (25, &ident[member])];

@@ -6,8 +6,11 @@
 use mpca::{Description, Drift, World, WorldBox};
 use mpca_gpu::{Gpu, GpuWorld};
 
+/// One device for every test of the binary: its pipelines are compiled
+/// once (a software adapter takes a while for it).
 fn gpu() -> Gpu {
-    Gpu::new().unwrap_or_else(|e| panic!("{e} (install mesa-vulkan-drivers for lavapipe)"))
+    static GPU: std::sync::OnceLock<Gpu> = std::sync::OnceLock::new();
+    GPU.get_or_init(|| Gpu::new().unwrap_or_else(|e| panic!("{e} (install mesa-vulkan-drivers for lavapipe)"))).clone()
 }
 
 /// A 2D gas of `nx x ny` cells at `density`, velocities uniform in the
