@@ -1328,27 +1328,10 @@ fn step_2d(@builtin(global_invocation_id) id: vec3<u32>) {
         }
         return;
     }
+    // The occupancy it owns, built up; everything else a particle carries
+    // is written to its cell as it is placed (what an empty cell holds is
+    // never read).
     var out_occ = array<u32, 2>(0u, 0u);
-    // The words of velocities it owns in each row: 16 (8-bit) or 32; of
-    // lifetimes, 16.
-    var out_vel: array<array<u32, 32>, 2>;
-    var out_life: array<array<u32, 16>, 2>;
-    var out_mass: array<array<u32, 16>, 2>;
-    var out_ident: array<array<u32, 64>, 2>;
-    for (var i = 0u; i < 64u; i++) {
-        out_ident[0][i] = 0u;
-        out_ident[1][i] = 0u;
-    }
-    for (var i = 0u; i < 32u; i++) {
-        out_vel[0][i] = 0u;
-        out_vel[1][i] = 0u;
-    }
-    for (var i = 0u; i < 16u; i++) {
-        out_life[0][i] = 0u;
-        out_life[1][i] = 0u;
-        out_mass[0][i] = 0u;
-        out_mass[1][i] = 0u;
-    }
     var counts = Counts(0u, 0u, vec2<u32>(0u, 0u), false, 0u, 0u, 0u, 0u);
     let sk = step_key(vec2<u32>(params[0], params[1]), step);
     // The blocks with a cell in [lo, hi): x0 + 1 >= lo and x0 < hi.
@@ -1455,18 +1438,29 @@ fn step_2d(@builtin(global_invocation_id) id: vec3<u32>) {
             }
             let row = t >> 1u;
             out_occ[row] |= 1u << (x - lo);
+            let cell = rows[row].at * nx + x;
+            // Halves of a word: two cells (rows of an even width start on
+            // a word), both this invocation's.
+            let half = 16u * (cell & 1u);
+            let keep = ~(0xffffu << half);
             if wide() {
-                out_vel[row][x - lo] = (u32(b.v[c].x) & 0xffffu) | u32(b.v[c].y) << 16u;
+                vel_out[cell] = (u32(b.v[c].x) & 0xffffu) | u32(b.v[c].y) << 16u;
             } else {
                 let byte_pair = (u32(b.v[c].x) & 0xffu) | (u32(b.v[c].y) & 0xffu) << 8u;
-                out_vel[row][(x - lo) >> 1u] |= byte_pair << (16u * (x & 1u));
+                vel_out[cell >> 1u] = (vel_out[cell >> 1u] & keep) | byte_pair << half;
             }
-            out_life[row][(x - lo) >> 1u] |= (max(b.life[c], 1u) - 1u) << (16u * (x & 1u));
-            out_mass[row][(x - lo) >> 1u] |= (b.mass[c] | b.tag[c] << 8u) << (16u * (x & 1u));
+            if params[36] != 0u {
+                life_out[cell >> 1u] = (life_out[cell >> 1u] & keep) | (max(b.life[c], 1u) - 1u) << half;
+            }
+            if masses_on() || (params[53] & 4u) != 0u {
+                mass_out[cell >> 1u] = (mass_out[cell >> 1u] & keep) | (b.mass[c] | b.tag[c] << 8u) << half;
+            }
             // M6b: the id and the tag go with the particle, its age counts
             // the step (saturating).
-            out_ident[row][2u * (x - lo)] = b.id[c];
-            out_ident[row][2u * (x - lo) + 1u] = select(b.age[c] + 1u, b.age[c], b.age[c] == 0xffffffffu);
+            if (params[53] & 3u) != 0u {
+                ident_out[2u * cell] = b.id[c];
+                ident_out[2u * cell + 1u] = select(b.age[c] + 1u, b.age[c], b.age[c] == 0xffffffffu);
+            }
         }
         // Counted by the invocation that owns the block's first cell inside.
         let owner = u32(max(x0, 0));
@@ -1487,27 +1481,6 @@ fn step_2d(@builtin(global_invocation_id) id: vec3<u32>) {
             continue;
         }
         occ_out[rows[row].at * row_u32 + w] = out_occ[row];
-        let shift = select(1u, 0u, wide());
-        let base = (rows[row].at * nx + lo) >> shift;
-        let words = (hi - lo) >> shift;
-        for (var k = 0u; k < words; k++) {
-            vel_out[base + k] = out_vel[row][k];
-        }
-        let first = (rows[row].at * nx + lo) >> 1u;
-        for (var k = 0u; k < (hi - lo) / 2u; k++) {
-            if params[36] != 0u {
-                life_out[first + k] = out_life[row][k];
-            }
-            if masses_on() || (params[53] & 4u) != 0u {
-                mass_out[first + k] = out_mass[row][k];
-            }
-        }
-        if (params[53] & 3u) != 0u {
-            let base = 2u * (rows[row].at * nx + lo);
-            for (var k = 0u; k < 2u * (hi - lo); k++) {
-                ident_out[base + k] = out_ident[row][k];
-            }
-        }
     }
     add_count(0u, counts.collisions);
     add_count(2u, counts.clamps);
