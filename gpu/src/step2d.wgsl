@@ -182,15 +182,28 @@ struct StepKey {
     stride: vec2<u32>,
 }
 
-fn step_key(seed: vec2<u32>, step: vec2<u32>) -> StepKey {
-    let a = mix64(seed ^ vec2<u32>(0x626c6b00u, 0x6d706361u));
+// A domain's key for a step: `domain` the blocks' or the emitters' tag,
+// `window` the bits of the counters each stream owns (16 a block, 32 an
+// emitter).
+fn step_key(seed: vec2<u32>, step: vec2<u32>, domain: vec2<u32>, window: u32) -> StepKey {
+    let a = mix64(seed ^ domain);
     let key = mix64(a ^ mul64(step, vec2<u32>(0x7f4a7c15u, 0x9e3779b9u)));
     var g = mix64(key ^ vec2<u32>(0x78bd642fu, 0xa0761d64u)) | vec2<u32>(1u, 0u);
     let t = g ^ shr64(g, 1u);
     if countOneBits(t.x) + countOneBits(t.y) < 24u {
         g = g ^ vec2<u32>(0xaaaaaaaau, 0xaaaaaaaau);
     }
-    return StepKey(key, g, shl64(g, 16u));
+    return StepKey(key, g, shl64(g, window));
+}
+
+// The stream `index` of a domain's key for a step.
+fn stream_of(k: StepKey, index: u32) -> Stream {
+    var s: Stream;
+    s.counter = add64(k.key, mul64(k.stride, vec2<u32>(index, 0u)));
+    s.gamma = k.gamma;
+    s.pool = vec2<u32>(0u, 0u);
+    s.left = 0u;
+    return s;
 }
 
 struct Stream {
@@ -1333,7 +1346,8 @@ fn step_2d(@builtin(global_invocation_id) id: vec3<u32>) {
     // never read).
     var out_occ = array<u32, 2>(0u, 0u);
     var counts = Counts(0u, 0u, vec2<u32>(0u, 0u), false, 0u, 0u, 0u, 0u);
-    let sk = step_key(vec2<u32>(params[0], params[1]), step);
+    // M8's block streams: their domain ("mpcablk"), 2^16 counters a block.
+    let sk = step_key(vec2<u32>(params[0], params[1]), step, vec2<u32>(0x626c6b00u, 0x6d706361u), 16u);
     // The blocks with a cell in [lo, hi): x0 + 1 >= lo and x0 < hi.
     let bx_lo = (i32(lo) - first.x) >> 1u;
     let bx_hi = (i32(hi) - 1 - first.x) >> 1u;
@@ -1408,11 +1422,7 @@ fn step_2d(@builtin(global_invocation_id) id: vec3<u32>) {
         }
         var block_counts = Counts(0u, 0u, vec2<u32>(0u, 0u), false, 0u, 1u, 0u, 0u);
         let index = u32(bx) + blocks.x * r;
-        var s: Stream;
-        s.counter = add64(sk.key, mul64(sk.stride, vec2<u32>(index, 0u)));
-        s.gamma = sk.gamma;
-        s.pool = vec2<u32>(0u, 0u);
-        s.left = 0u;
+        var s = stream_of(sk, index);
         change(&b, site.at, &s, &block_counts);
         let want = desire(&b, &site, &s, &block_counts);
         let targets = assign(&b, site.blocked, want, &s, &block_counts);
@@ -1507,24 +1517,15 @@ fn step_2d(@builtin(global_invocation_id) id: vec3<u32>) {
 fn emit() {
     let step = vec2<u32>(atomicLoad(&counters[13]), atomicLoad(&counters[14]));
     let seed = vec2<u32>(params[0], params[1]);
-    // M8's emitter streams: their own domain, 2^32 counters an emitter.
-    let a = mix64(seed ^ vec2<u32>(0x656d6900u, 0x6d706361u));
-    let key = mix64(a ^ mul64(step, vec2<u32>(0x7f4a7c15u, 0x9e3779b9u)));
-    var gamma = mix64(key ^ vec2<u32>(0x78bd642fu, 0xa0761d64u)) | vec2<u32>(1u, 0u);
-    let t = gamma ^ shr64(gamma, 1u);
-    if countOneBits(t.x) + countOneBits(t.y) < 24u {
-        gamma = gamma ^ vec2<u32>(0xaaaaaaaau, 0xaaaaaaaau);
-    }
+    // M8's emitter streams: their own domain ("mpcaemi"), 2^32 counters
+    // an emitter.
+    let key = step_key(seed, step, vec2<u32>(0x656d6900u, 0x6d706361u), 32u);
     let nx = params[6];
     let row_u32 = params[8];
     let unit = params[11];
     for (var i = 0u; i < params[35]; i++) {
         let e = 16u * i;
-        var s: Stream;
-        s.counter = add64(key, vec2<u32>(0u, gamma.x * i));
-        s.gamma = gamma;
-        s.pool = vec2<u32>(0u, 0u);
-        s.left = 0u;
+        var s = stream_of(key, i);
         var wanted = vec2<u32>(emitters[e + 4u], emitters[e + 5u]);
         if bits(&s, 24u) < emitters[e + 6u] && !all(wanted == vec2<u32>(0xffffffffu)) {
             wanted = add64(wanted, vec2<u32>(1u, 0u));
