@@ -1,13 +1,17 @@
 //! What a second implementation of the step needs from this one: the
-//! integers a step converts its settings to (M1c), the tables of the rule
-//! (M5.2's turns, M5.3's move limits, M5.6's 2D assignments), the world's
-//! occupancy and velocity planes to copy in and out, and the counters and
-//! step number it hands back. The GPU backend (`mpca-gpu`) is one: it runs
+//! integers a step converts its settings to (M1c: per world, per mass
+//! class, per emitter, per surface entry), the tables of the rule (M5.2's
+//! turns, M5.3's move limits, M5.6's 2D assignments), the planes a step
+//! reads (obstacles, force fields, potentials, wind) and those it changes
+//! (occupancy, velocities, lifetimes, mass indices, ids, ages and tags) to
+//! copy out and, checked, back in, with the counters and step number it
+//! hands back. The GPU backend (`mpca-gpu`) is one: it runs
 //! the block rule in a shader and keeps this crate's worlds, so that both
 //! give the same world bit for bit (M8b). Nothing here is needed to use a
 //! world.
 
 use crate::api::desc::Drift;
+use crate::api::error::Error;
 use crate::rules::emitter::{split_rate, EmitterStats};
 use crate::rules::fixed::{csqrt, divr, magnitude, parts, scaled, scaled_by, to_fine, unit_scale};
 use crate::rules::force::Swirl;
@@ -16,7 +20,6 @@ use crate::rules::quant::Quant;
 use crate::rules::rng::StepKey;
 use crate::step::convert_class;
 use crate::step::partition::Partition;
-use crate::api::error::Error;
 use crate::storage::world::{Counters, World};
 
 /// The integers one step of a world reads, converted from its description
