@@ -4,8 +4,9 @@
 //! snapshot image after every step.
 //!
 //! The world lives in GPU buffers: the occupancy, one bit a cell as the CPU
-//! keeps it, and the stored velocities, as bytes, each in a pair of buffers
-//! that the steps read and write in turn. A copy of the world on the CPU
+//! keeps it, the stored velocities and what particles carry (lifetimes,
+//! mass indices, ids, ages, tags), each in a pair of buffers that the
+//! steps read and write in turn, and the planes a step only reads. A copy of the world on the CPU
 //! (an [`mpca::World`]) keeps what does not change in a step (the
 //! description) and what a step counts; [`GpuWorld::sync`] brings the
 //! planes and the counters down into it, which checks them, and from there

@@ -1,5 +1,4 @@
-// The local map of M5 on the 2D blocks of one step, for 8-bit and 16-bit
-// storage and one mass, as docs/model.md states it (M1c, M3, M4, M5, M8). One invocation owns one
+// The local map of M5 on the 2D blocks of one step, every part of it, as docs/model.md states it (M1c, M3, M4, M5, M8). One invocation owns one
 // 32-cell word of the occupancy in each of the two domain rows of a row of
 // blocks, and the velocities of those cells: it processes every block that
 // touches them (at offset 1 the two blocks that straddle its edges are also
