@@ -1,11 +1,12 @@
-// The local map of M5 on the 2D blocks of one step, every part of it, as docs/model.md states it (M1c, M3, M4, M5, M8). One invocation owns one
+// The local map of M5 on the 2D blocks of one step, every part of it, as
+// docs/model.md states it (M1c, M3, M4, M5, M8). One invocation owns one
 // 32-cell word of the occupancy in each of the two domain rows of a row of
-// blocks, and the velocities of those cells: it processes every block that
-// touches them (at offset 1 the two blocks that straddle its edges are also
-// processed by its neighbours, each with the same result) and writes only
-// what it owns, into the other buffer of the pair. No two invocations write
-// the same word. A block's counts go to the invocation that owns its first
-// cell.
+// blocks, and everything the particles in those cells carry: it processes
+// every block that touches them (at offset 1 the two blocks that straddle
+// its edges are also processed by its neighbours, each with the same result)
+// and writes only what it owns, into the other buffer of the pair. No two
+// invocations write the same word. A block's counts go to the invocation
+// that owns its first cell.
 //
 // 64-bit integers are vec2<u32> (low, high): WGSL has none.
 
