@@ -274,32 +274,22 @@ impl GpuWorld {
         let device = &gpu.device;
         let desc = *host.description();
         let (nx, ny) = (desc.size[0], desc.size[1]);
-        let p = host.port_planes();
-        let (occupancy, velocity, life, mass, ident) = (bytemuck::cast_slice::<u64, u8>(p.occupancy).to_vec(), p.velocity.to_vec(), p.life.to_vec(), carried(&p), identities(&p));
+        let c = Contents::of(&host);
         let storage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
-        let buffer = |label: &str, bytes: &[u8]| device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents: &padded(bytes), usage: storage });
-        let occupancy = [buffer("occupancy 0", &occupancy), buffer("occupancy 1", &occupancy)];
-        let velocity = [buffer("velocity 0", &velocity), buffer("velocity 1", &velocity)];
-        let life = [buffer("life 0", &life), buffer("life 1", &life)];
-        let mass = [buffer("mass index 0", &mass), buffer("mass index 1", &mass)];
-        let ident = [buffer("ids and ages 0", &ident), buffer("ids and ages 1", &ident)];
-        let classes = buffer("classes", bytemuck::cast_slice(&class_table(&host)));
-        let f = host.port_fields();
-        let fields = [buffer("force field", f.force), buffer("potential", f.potential), buffer("wind", f.wind)];
-        // Room for every surface entry the world can hold: an image may
-        // bring more.
-        let obstacles = [buffer("obstacles", bytemuck::cast_slice(host.port_obstacles())), buffer("surfaces", &surface_bytes(&host))];
-        let counters = buffer("counters", bytemuck::cast_slice(&counters_of(&host)));
-        let params = buffer("params", bytemuck::cast_slice(&params(&host.port_constants(), &desc, emitter_count(&host) as u32, surface_table(&host).len() as u32 / 4)));
-        let tables = buffer("tables", bytemuck::cast_slice(&tables(mpca::port::move_table_8(desc.drift))));
+        let buffer = |label: &str, bytes: &[u8]| device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents: bytes, usage: storage });
+        let pair = |label: &str, bytes: &[u8]| [buffer(label, bytes), buffer(label, bytes)];
+        let [occupancy, velocity, life, mass, ident] = [("occupancy", 0), ("velocity", 1), ("life", 2), ("mass index and tag", 3), ("ids and ages", 4)].map(|(label, i)| pair(label, &c.planes[i]));
+        let classes = buffer("classes", &c.classes);
+        let fields = [("force field", 0), ("potential", 1), ("wind", 2)].map(|(label, i)| buffer(label, &c.fields[i]));
+        let obstacles = [buffer("obstacles", &c.obstacles), buffer("surfaces", &c.surfaces)];
+        let counters = buffer("counters", &c.counters);
+        let params = buffer("params", &c.params);
+        let tables = buffer("tables", &c.tables);
         let shared = gpu.pipelines.get_or_init(|| Pipelines::of(device));
         let (pipeline, end) = (shared.step.clone(), shared.end.clone());
-        // Room for every emitter the world can hold: an image may bring
-        // another count.
-        let capacity = desc.emitter_capacity as usize;
-        let emitters = buffer("emitters", bytemuck::cast_slice(&emitter_table(&host, capacity)));
-        let emitter_stats = buffer("emitter stats", &vec![0u8; 16 * capacity]);
-        let emit = (capacity > 0).then(|| {
+        let emitters = buffer("emitters", &c.emitters);
+        let emitter_stats = buffer("emitter stats", &c.emitter_stats);
+        let emit = (desc.emitter_capacity > 0).then(|| {
             let pipeline = shared.emit.clone();
             let layout = pipeline.get_bind_group_layout(0);
             let group = |member: usize| {
@@ -370,26 +360,16 @@ impl GpuWorld {
         }
         let mut host = WorldBox::new(&desc)?;
         host.load(image)?;
-        let queue = &self.gpu.queue;
-        let p = host.port_planes();
-        queue.write_buffer(&self.occupancy[self.current], 0, bytemuck::cast_slice(p.occupancy));
-        queue.write_buffer(&self.velocity[self.current], 0, &padded(p.velocity));
-        queue.write_buffer(&self.life[self.current], 0, &padded(p.life));
-        queue.write_buffer(&self.mass[self.current], 0, &padded(&carried(&p)));
-        queue.write_buffer(&self.ident[self.current], 0, &padded(&identities(&p)));
-        queue.write_buffer(&self.classes, 0, bytemuck::cast_slice(&class_table(&host)));
-        let f = host.port_fields();
-        for (buffer, plane) in self.fields.iter().zip([f.force, f.potential, f.wind]) {
-            queue.write_buffer(buffer, 0, &padded(plane));
+        // The same plan as the world's (checked by the load): every buffer
+        // keeps its size.
+        let c = Contents::of(&host);
+        let now = self.current;
+        let planes = [&self.occupancy[now], &self.velocity[now], &self.life[now], &self.mass[now], &self.ident[now]].into_iter().zip(&c.planes);
+        let fields = self.fields.iter().zip(&c.fields);
+        let rest = [(&self.classes, &c.classes), (&self.obstacles[0], &c.obstacles), (&self.obstacles[1], &c.surfaces), (&self.counters, &c.counters), (&self.params, &c.params), (&self.tables, &c.tables), (&self.emitters, &c.emitters), (&self.emitter_stats, &c.emitter_stats)];
+        for (buffer, bytes) in planes.chain(fields).chain(rest) {
+            self.gpu.queue.write_buffer(buffer, 0, bytes);
         }
-        queue.write_buffer(&self.obstacles[0], 0, &padded(bytemuck::cast_slice(host.port_obstacles())));
-        queue.write_buffer(&self.obstacles[1], 0, &surface_bytes(&host));
-        queue.write_buffer(&self.counters, 0, bytemuck::cast_slice(&counters_of(&host)));
-        queue.write_buffer(&self.params, 0, bytemuck::cast_slice(&params(&host.port_constants(), &desc, emitter_count(&host) as u32, surface_table(&host).len() as u32 / 4)));
-        queue.write_buffer(&self.tables, 0, bytemuck::cast_slice(&tables(mpca::port::move_table_8(desc.drift))));
-        let capacity = self.emitter_stats.size() as usize / 16;
-        queue.write_buffer(&self.emitters, 0, &padded(bytemuck::cast_slice(&emitter_table(&host, capacity))));
-        queue.write_buffer(&self.emitter_stats, 0, &vec![0u8; 16 * capacity]);
         self.host = host;
         self.pending = 0;
         Ok(())
@@ -487,6 +467,53 @@ impl GpuWorld {
 
 }
 
+/// The bytes every buffer of a GPU world starts from, made from the world's
+/// CPU copy, each padded to a buffer's size: what [`GpuWorld::new`] fills
+/// its buffers with and [`GpuWorld::load`] writes into them.
+struct Contents {
+    /// The planes of a pair: occupancy, velocities, lifetimes, mass indices
+    /// and tags, ids and ages.
+    planes: [Vec<u8>; 5],
+    classes: Vec<u8>,
+    /// The force field, potential and wind planes.
+    fields: [Vec<u8>; 3],
+    obstacles: Vec<u8>,
+    /// With room for every entry the description allows (an image may
+    /// bring more than the world has).
+    surfaces: Vec<u8>,
+    counters: Vec<u8>,
+    params: Vec<u8>,
+    tables: Vec<u8>,
+    /// With room for every emitter the description allows.
+    emitters: Vec<u8>,
+    emitter_stats: Vec<u8>,
+}
+
+impl Contents {
+    fn of(host: &World) -> Contents {
+        let desc = host.description();
+        let p = host.port_planes();
+        let f = host.port_fields();
+        let words = |w: &[u32]| padded(bytemuck::cast_slice(w));
+        let mut surfaces = surface_table(host);
+        let count = surfaces.len() / 4;
+        surfaces.resize(4 * (desc.surface_capacity as usize).max(1), 0);
+        let capacity = desc.emitter_capacity as usize;
+        Contents {
+            planes: [padded(bytemuck::cast_slice(p.occupancy)), padded(p.velocity), padded(p.life), padded(&carried(&p)), padded(&identities(&p))],
+            classes: words(&class_table(host)),
+            fields: [f.force, f.potential, f.wind].map(padded),
+            obstacles: padded(bytemuck::cast_slice(host.port_obstacles())),
+            surfaces: words(&surfaces),
+            counters: words(&counters_of(host)),
+            params: words(&params(&host.port_constants(), desc, emitter_count(host) as u32, count as u32)),
+            tables: words(&tables(mpca::port::move_table_8(desc.drift))),
+            emitters: words(&emitter_table(host, capacity)),
+            emitter_stats: padded(&vec![0u8; 16 * capacity]),
+        }
+    }
+}
+
 /// `bytes` padded to a buffer's size: a multiple of 4 bytes, at least 4.
 fn padded(bytes: &[u8]) -> Vec<u8> {
     let mut contents = bytes.to_vec();
@@ -498,14 +525,6 @@ fn padded(bytes: &[u8]) -> Vec<u8> {
 /// (`step2d.wgsl`): cell, normal x and y in Q30, restitution in Q16.
 fn surface_table(host: &World) -> Vec<u32> {
     (0..).map_while(|i| host.port_surface(i)).flat_map(|e| [e.cell, e.normal[0] as u32, e.normal[1] as u32, e.restitution as u32]).collect()
-}
-
-/// [`surface_table`] as bytes, with room for every entry the world's
-/// description allows.
-fn surface_bytes(host: &World) -> Vec<u8> {
-    let mut table = surface_table(host);
-    table.resize(4 * (host.description().surface_capacity as usize).max(1), 0);
-    bytemuck::cast_slice(&table).to_vec()
 }
 
 /// What the shader keeps of a world's mass indices and tags: 16 bits a
