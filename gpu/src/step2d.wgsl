@@ -1250,6 +1250,22 @@ fn occupied(x: u32, y: u32) -> u32 {
     return occ_in[y * params[8] + (x >> 5u)] >> (x & 31u) & 1u;
 }
 
+// `word` with the 16 bits of cell `cell` set to `value`: planes of 16 bits
+// a cell keep two cells a word (rows of an even width start on a word).
+fn with_half(word: u32, cell: u32, value: u32) -> u32 {
+    let half = 16u * (cell & 1u);
+    return (word & ~(0xffffu << half)) | (value & 0xffffu) << half;
+}
+
+// A stored velocity as its plane keeps it: two bytes in the low half of a
+// word (8-bit storage), or two 16-bit halves.
+fn stored(q: vec2<i32>) -> u32 {
+    if wide() {
+        return (u32(q.x) & 0xffffu) | u32(q.y) << 16u;
+    }
+    return (u32(q.x) & 0xffu) | (u32(q.y) & 0xffu) << 8u;
+}
+
 // The stored velocity of cell (x, y): two bytes a cell, two cells a word
 // (8-bit), or two 16-bit halves, a word a cell (16-bit).
 fn velocity(x: u32, y: u32) -> vec2<i32> {
@@ -1448,22 +1464,18 @@ fn step_2d(@builtin(global_invocation_id) id: vec3<u32>) {
             }
             let row = t >> 1u;
             out_occ[row] |= 1u << (x - lo);
+            // Where two cells share a word, both are this invocation's.
             let cell = rows[row].at * nx + x;
-            // Halves of a word: two cells (rows of an even width start on
-            // a word), both this invocation's.
-            let half = 16u * (cell & 1u);
-            let keep = ~(0xffffu << half);
             if wide() {
-                vel_out[cell] = (u32(b.v[c].x) & 0xffffu) | u32(b.v[c].y) << 16u;
+                vel_out[cell] = stored(b.v[c]);
             } else {
-                let byte_pair = (u32(b.v[c].x) & 0xffu) | (u32(b.v[c].y) & 0xffu) << 8u;
-                vel_out[cell >> 1u] = (vel_out[cell >> 1u] & keep) | byte_pair << half;
+                vel_out[cell >> 1u] = with_half(vel_out[cell >> 1u], cell, stored(b.v[c]));
             }
             if params[36] != 0u {
-                life_out[cell >> 1u] = (life_out[cell >> 1u] & keep) | (max(b.life[c], 1u) - 1u) << half;
+                life_out[cell >> 1u] = with_half(life_out[cell >> 1u], cell, max(b.life[c], 1u) - 1u);
             }
             if masses_on() || (params[53] & 4u) != 0u {
-                mass_out[cell >> 1u] = (mass_out[cell >> 1u] & keep) | (b.mass[c] | b.tag[c] << 8u) << half;
+                mass_out[cell >> 1u] = with_half(mass_out[cell >> 1u], cell, b.mass[c] | b.tag[c] << 8u);
             }
             // M6b: the id and the tag go with the particle, its age counts
             // the step (saturating).
@@ -1582,19 +1594,16 @@ fn emit() {
                 occ_emit[word] |= 1u << (x & 31u);
                 let cell = y * nx + x;
                 if wide() {
-                    vel_emit[cell] = (u32(q.x) & 0xffffu) | u32(q.y) << 16u;
+                    vel_emit[cell] = stored(q);
                 } else {
-                    let shift = 16u * (cell & 1u);
-                    let pair = (u32(q.x) & 0xffu) | (u32(q.y) & 0xffu) << 8u;
-                    vel_emit[cell >> 1u] = (vel_emit[cell >> 1u] & ~(0xffffu << shift)) | pair << shift;
+                    vel_emit[cell >> 1u] = with_half(vel_emit[cell >> 1u], cell, stored(q));
                 }
-                let half = 16u * (cell & 1u);
                 if params[36] != 0u {
-                    life_emit[cell >> 1u] = (life_emit[cell >> 1u] & ~(0xffffu << half)) | (emitters[e + 10u] & 0xffffu) << half;
+                    life_emit[cell >> 1u] = with_half(life_emit[cell >> 1u], cell, emitters[e + 10u]);
                 }
                 if masses_on() || (params[53] & 4u) != 0u {
                     let carried = select(0u, emitters[e + 11u] & 0xffu, masses_on()) | (emitters[e + 12u] & 0xffu) << 8u;
-                    mass_emit[cell >> 1u] = (mass_emit[cell >> 1u] & ~(0xffffu << half)) | carried << half;
+                    mass_emit[cell >> 1u] = with_half(mass_emit[cell >> 1u], cell, carried);
                 }
                 // M6b: the next id, age 0.
                 if (params[53] & 1u) != 0u {
