@@ -595,15 +595,16 @@ fn face(b: Boundary) -> u32 {
 }
 
 /// The shader's parameters, the same every step (`step2d.wgsl`), from
-/// the constants of any step `c`.
+/// the world's constants `c`; what depends on the mass is in the class
+/// table ([`class_table`]).
 fn params(c: &StepConstants, d: &Description, d_emitters: u32, surfaces: u32) -> [u32; PARAMS] {
     let lo = |x: u64| x as u32;
     let hi = |x: u64| (x >> 32) as u32;
     let (nx, ny) = (d.size[0], d.size[1]);
     let faces = face(d.boundary[0][0]) | face(d.boundary[0][1]) << 2 | face(d.boundary[1][0]) << 4 | face(d.boundary[1][1]) << 6;
     let g = c.push.map(|g| g as u64);
-    let v = c.vortex.unwrap_or(VortexConstants { centre: [0; 2], core: 0, force: None, flow: None });
-    let (force, flow) = (v.force.unwrap_or_default(), v.flow.unwrap_or_default());
+    let v = c.vortex.unwrap_or(VortexConstants { centre: [0; 2], core: 0, flow: None });
+    let flow = v.flow.unwrap_or_default();
     let drag = c.drag.unwrap_or(DragConstants { keep: 0, wind: [0; 3], field: false });
     let on = |x: bool| u32::from(x);
     [
@@ -619,8 +620,8 @@ fn params(c: &StepConstants, d: &Description, d_emitters: u32, surfaces: u32) ->
         u32::from(d.quantization == Quantization::Bits16),
         c.restitution as u32,
         c.unit as u32,
-        c.energy.0,
-        c.energy.1 as u32,
+        0,
+        0,
         faces,
         c.wall_restitution as u32,
         lo(g[0]),
@@ -629,22 +630,22 @@ fn params(c: &StepConstants, d: &Description, d_emitters: u32, surfaces: u32) ->
         hi(g[1]),
         lo(g[2]),
         hi(g[2]),
-        on(c.push != [0; 3] || v.force.is_some() || d.forces.field || d.forces.potential),
+        on(c.push != [0; 3] || d.forces.vortex || d.forces.field || d.forces.potential),
         u32::from(d.drift == Drift::Calibrated),
         u32::from(d.collisions == Collisions::SpeedLimited),
         c.speed_limit as u32,
         u32::from(d.contacts),
-        on(v.force.is_some()),
+        on(d.forces.vortex),
         lo(v.centre[0] as u64),
         hi(v.centre[0] as u64),
         lo(v.centre[1] as u64),
         hi(v.centre[1] as u64),
         v.core,
-        force.0 as u32,
-        force.1 as u32,
+        0,
+        0,
         d_emitters,
         on(d.lifetimes),
-        c.class_push,
+        0,
         on(d.forces.potential),
         on(d.forces.field),
         surfaces,

@@ -12,21 +12,22 @@
 
 // params, the same every step: 0-1 the seed, 6 nx, 7 ny, 8 u32 words a row
 // of the occupancy, 9 the storage's width (0: 8 bits, 1: 16), 10
-// restitution (Q16), 11 unit W, 12-13 the clamp's
-// energy factor (significand, exponent), 14 the faces (2 bits each: x low,
-// x high, y low, y high; 0 periodic, 1 wall, 2 open), 15 the walls'
-// restitution (Q16), 16-21 the uniform push G (x, y, z as 64-bit pairs), 22
-// whether a force is on (G not 0, or the vortex), 23 the calibrated drift rule, 24 speed-limited
-// collisions (M5.2b), 25 their limit L (fine units), 26 contacts (M5.7),
-// 27 the vortex force (M5.1), 28-31 its centre (x, y as 64-bit pairs,
-// 2^-8 cells), 32 its core (2^-8 cells), 33-34 its strength top(Γ') (g,
-// e), 35 the emitters, 36 lifetimes, 37 K = dt / m (f32 bits), 38 the
-// potential, 39 the force field, 41-42 the vortex's strength as a flow
-// top(Γ'') (g, e), 43 drag (M5.1b), 44 its weight C (Q16), 45-46 the
-// uniform wind U (fine units), 47 the flow holds the wind plane, 48 the
-// flow holds the vortex, 49 S (quanta to a unit speed), 40 the surface
-// entries, 50 obstacles, 51 energy-neutral rounding (M1b), 52 masses, 53
-// M6b's planes, 54 M5.6's method (0 exhaustive, 1 exact-fast, 2 greedy).
+// restitution (Q16), 11 unit W, 14 the faces (2 bits each: x low, x high, y
+// low, y high; 0 periodic, 1 wall, 2 open), 15 the walls' restitution
+// (Q16), 16-21 the uniform push G (x, y, z as 64-bit pairs), 22 whether a
+// force is on (G not 0, a field, a potential or the vortex), 23 the
+// calibrated drift rule, 24 speed-limited collisions (M5.2b), 25 their
+// limit L (fine units), 26 contacts (M5.7), 27 the vortex force (M5.1),
+// 28-31 the vortex's centre (x, y as 64-bit pairs, 2^-8 cells), 32 its
+// core (2^-8 cells), 35 the emitters, 36 lifetimes, 38 the potential, 39
+// the force field, 40 the surface entries, 41-42 the vortex's strength as
+// a flow top(Γ'') (g, e), 43 drag (M5.1b), 44 its weight C (Q16), 45-46
+// the uniform wind U (fine units), 47 the flow holds the wind plane, 48
+// the flow holds the vortex, 49 S (quanta to a unit speed), 50 obstacles,
+// 51 energy-neutral rounding (M1b), 52 masses, 53 M6b's planes, 54 M5.6's
+// method (0 exhaustive, 1 exact-fast, 2 greedy). 2-5, 12-13, 33-34 and 37
+// are 0: what depends on the mass (K, the clamp's energy factor, the
+// vortex force's strength) is in `classes`, per mass index.
 @group(0) @binding(0) var<storage, read> params: array<u32>;
 // tables: 0..256 M5.3 move limits; 256..2304 the turns of M5.2 (cos, sin
 // as i32); 2304..3600 per 2D key its assignments (start | count << 16,

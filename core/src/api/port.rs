@@ -16,8 +16,7 @@ use crate::rules::emitter::{split_rate, EmitterStats};
 use crate::rules::fixed::{csqrt, divr, magnitude, parts, scaled, scaled_by, to_fine, unit_scale};
 use crate::rules::force::Swirl;
 use crate::rules::obstacle::{normal_q30, Surface};
-use crate::rules::quant::Quant;
-use crate::rules::rng::StepKey;
+use crate::rules::quant::unit_of;
 use crate::step::convert_class;
 use crate::step::partition::Partition;
 use crate::storage::world::{Counters, World};
@@ -26,15 +25,6 @@ use crate::storage::world::{Counters, World};
 /// as the step converts them (M1c, M8).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct StepConstants {
-    /// The step's number: its parity is the partition's offset (M3).
-    pub step: u64,
-    /// M8: block `b`'s stream starts at the counter `key + stride b` and
-    /// adds `gamma` before each output.
-    pub key: u64,
-    /// See `key`.
-    pub gamma: u64,
-    /// See `key`: `gamma` times the counters a block owns.
-    pub stride: u64,
     /// M5.1's uniform push `G` per axis in fine units, 0 where the force
     /// is off (M1c).
     pub push: [i64; 3],
@@ -49,35 +39,26 @@ pub struct StepConstants {
     pub unit: i32,
     /// Fine bits per quantum, `F` (M1c).
     pub fine: u32,
-    /// M5.5's energy factor `h` of the world's mass as `h = m 2^e`: the
-    /// counter adds `floor(n h)` for `n` cut to its top 40 bits.
-    pub energy: (u32, i32),
     /// M5.3: per stored 8-bit component (as a byte), the largest 16
     /// random bits that say "move".
     pub moves: &'static [u16; 256],
     /// M5.1's Rankine vortex, where the force or the flow of M5.1b reads
-    /// it (M1c).
+    /// it (M1c); its strength as a force is each mass class's
+    /// ([`World::port_class`]).
     pub vortex: Option<VortexConstants>,
-    /// M1c's `K = quot(dt, m)` for the world's mass, as the bits of its
-    /// `f32`: the field's and the potential's pushes are `conv(f, K S, F)`.
-    pub class_push: u32,
     /// M5.1b's drag, where its rate is not 0.
     pub drag: Option<DragConstants>,
 }
 
 /// M5.1's vortex as the step reads it (M1c): its centre and core radius
-/// in `2^-8` cells, and its strengths as `top(Γ)`, each a 16-bit
-/// significand `g` (signed) and an exponent `e`: as a force for the
-/// world's mass (`Γ'`) where the force is on, and as a flow (`Γ''`) where
-/// the drag reads it.
+/// in `2^-8` cells, and, where the drag's flow holds it, its strength as a
+/// flow `top(Γ'')`: a 16-bit significand `g` (signed) and an exponent `e`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct VortexConstants {
     /// See the type.
     pub centre: [i64; 2],
     /// See the type.
     pub core: u32,
-    /// `(g, e)` of `Γ'`, where the force is on.
-    pub force: Option<(i32, i32)>,
     /// `(g, e)` of `Γ''`, where the drag's flow holds the vortex.
     pub flow: Option<(i32, i32)>,
 }
@@ -213,25 +194,16 @@ pub struct PortFields<'a> {
 impl World {
     /// The integers of the step this world takes next (M1c, M8).
     pub fn port_constants(&self) -> StepConstants {
-        let step = self.head.step;
         let desc = &self.head.desc;
-        let unit = crate::rules::quant::with_quant!(desc.quantization, Q => Q::UNIT);
-        let (s, fine) = (unit >> unit.trailing_zeros(), unit.trailing_zeros());
-        let class = convert_class(magnitude(desc.mass), magnitude(desc.mass), desc.dt, (s as u32, fine as i32), None);
-        let (_, m, e) = parts(class.energy);
-        let (key, gamma, stride) = StepKey::blocks(desc.seed, step).parts();
+        let unit = unit_of(desc.quantization);
+        let (s, fine) = unit_scale(unit);
         StepConstants {
-            step,
-            key,
-            gamma,
-            stride,
-            push: if desc.forces.uniform { desc.gravity.map(|g| scaled_by(desc.dt, g, s as u32, fine as i32)) } else { [0; 3] },
+            push: if desc.forces.uniform { desc.gravity.map(|g| scaled_by(desc.dt, g, s, fine)) } else { [0; 3] },
             restitution: scaled(desc.restitution, 1.0, 16) as i32,
             wall_restitution: scaled(desc.wall_restitution, 1.0, 16) as i32,
             speed_limit: unit - csqrt(u64::from(desc.dim) << (2 * fine), 1 << fine) as i32,
             unit,
-            fine,
-            energy: (m as u32, e),
+            fine: fine as u32,
             moves: crate::rules::quant::move_table_8(desc.drift),
             vortex: {
                 let force = cfg!(feature = "vortex") && desc.forces.vortex;
@@ -239,17 +211,13 @@ impl World {
                 (force || flow).then(|| {
                     let swirl = Swirl::of(&desc.vortex);
                     let (centre, core) = swirl.integers();
-                    let top = |k: f32| {
-                        let t = swirl.gamma(k, (s as u32, fine as i32));
-                        (t.g, t.e)
-                    };
-                    VortexConstants { centre, core, force: force.then(|| top(class.push)), flow: flow.then(|| top(1.0)) }
+                    let top = swirl.gamma(1.0, (s, fine));
+                    VortexConstants { centre, core, flow: flow.then_some((top.g, top.e)) }
                 })
             },
-            class_push: class.push.to_bits(),
             drag: desc.has_drag().then(|| DragConstants {
                 keep: divr(1 << 48, (1 << 32) + scaled(desc.dt, desc.drag.rate, 32) as u64) as i32,
-                wind: desc.drag.wind.map(|u| to_fine(u, (s as u32, fine as i32))),
+                wind: desc.drag.wind.map(|u| to_fine(u, (s, fine))),
                 field: desc.drag.field,
             }),
         }
@@ -259,7 +227,7 @@ impl World {
     pub fn port_emitter(&self, i: usize) -> Option<EmitterConstants> {
         let slot = self.slots().get(i)?;
         let e = slot.emitter;
-        let scale = unit_scale(crate::rules::quant::unit_of(self.head.desc.quantization));
+        let scale = unit_scale(unit_of(self.head.desc.quantization));
         let (whole, threshold) = split_rate(e.rate);
         Some(EmitterConstants {
             min: e.min,
@@ -294,15 +262,17 @@ impl World {
     /// particle (the first).
     pub fn port_class(&self, i: u8) -> ClassConstants {
         let desc = &self.head.desc;
-        let unit = crate::rules::quant::unit_of(desc.quantization);
-        let scale = (unit_scale(unit).0, unit_scale(unit).1);
         let table: &[f32] = self.plane(self.layout().mass_table());
         let used = if desc.has_masses() { &table[..(self.head.masses as usize).min(desc.mass_classes as usize).min(table.len())] } else { &[] };
-        // Masses are positive (checked): their bits order them as numbers.
-        let largest = magnitude(f32::from_bits(used.iter().fold(desc.mass.to_bits() * u32::from(used.is_empty()), |a, &m| a.max(m.to_bits()))));
-        let mass = used.get(usize::from(i)).or(used.first()).map_or(magnitude(desc.mass), |&m| magnitude(m));
+        // As the step converts them: the classes in use against the
+        // largest of them (masses are positive, checked: their bits order
+        // them as numbers), or the world's one mass.
+        let (mass, largest) = match used.iter().map(|m| m.to_bits()).max() {
+            Some(largest) => (used.get(usize::from(i)).unwrap_or(&used[0]).to_bits(), largest),
+            None => (desc.mass.to_bits(), desc.mass.to_bits()),
+        };
         let swirl = (cfg!(feature = "vortex") && desc.forces.vortex).then(|| Swirl::of(&desc.vortex));
-        let class = convert_class(mass, largest, desc.dt, scale, swirl);
+        let class = convert_class(magnitude(f32::from_bits(mass)), magnitude(f32::from_bits(largest)), desc.dt, unit_scale(unit_of(desc.quantization)), swirl);
         let (_, m, e) = parts(class.energy);
         ClassConstants {
             relative: class.relative,

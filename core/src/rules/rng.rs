@@ -75,12 +75,6 @@ impl StepKey {
         StepKey::derive(seed, step, DOMAIN_BLOCK, BLOCK_WINDOW)
     }
 
-    /// The key, the increment and the stride between blocks' first
-    /// counters, for a second implementation of the streams (`port`).
-    pub(crate) fn parts(&self) -> (u64, u64, u64) {
-        (self.key, self.gamma, self.stride)
-    }
-
     /// The emitter streams of `step`.
     pub fn emitters(seed: u64, step: u64) -> StepKey {
         StepKey::derive(seed, step, DOMAIN_EMITTER, EMITTER_WINDOW)
