@@ -169,7 +169,8 @@ pub struct PortPlanes<'a> {
 pub struct ClassConstants {
     /// `M`: the mass relative to the largest in use, `2^24` for that one.
     pub relative: u32,
-    /// M5.5's energy factor `h = m 2^e`, as [`StepConstants::energy`].
+    /// M5.5's energy factor `h = m 2^e`: the clamp's counter adds
+    /// `floor(n h)` for `n` cut to its top 40 bits.
     pub energy: (u32, i32),
     /// `K = quot(dt, m)`, as the bits of its `f32`.
     pub push: u32,
