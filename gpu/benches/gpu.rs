@@ -7,9 +7,10 @@
 //! step (and is counted in), the CPU's with the last step.
 //!
 //! Worlds: the 2D gas at density 0.3 (`mpca_tests::scenes::full_gas`) at
-//! 4096^2; `MPCA_GPU_BENCH_LARGE=1` adds 16384^2 (a world of about 600 MB
-//! on each side). 3D water is not run: this version of the backend has no
-//! 3D rule.
+//! 4096^2; `MPCA_GPU_BENCH_LARGE=1` adds 16384^2 (off by default: that
+//! world is held on the CPU and on the GPU at once, and its steps take long
+//! on a software adapter). 3D water is not run: this version of the backend
+//! has no 3D rule.
 
 use std::time::Instant;
 

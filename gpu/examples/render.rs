@@ -120,8 +120,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         pass.set_vertex_buffer(0, exports.particles.slice(..));
         pass.draw_indirect(&exports.draw, 0);
     }
-    // The picture alone comes back: rows padded to 256 bytes.
-    let row = (4 * pixels).next_multiple_of(256);
+    // The picture alone comes back, its rows padded as a copy to a buffer
+    // needs.
+    let row = (4 * pixels).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
     let picture = device.create_buffer(&wgpu::BufferDescriptor { label: Some("picture"), size: u64::from(row) * u64::from(pixels), usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ, mapped_at_creation: false });
     encoder.copy_texture_to_buffer(
         target.as_image_copy(),

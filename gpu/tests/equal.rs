@@ -247,8 +247,8 @@ fn steps_recorded_into_the_callers_encoder_step_as_on_the_cpu() {
 /// Steps `w` and a GPU copy of it 9 steps, with the exports recorded in
 /// the same encoder after the steps, and checks every particle's cell and
 /// velocity in the CPU's order, the draw's count, and the density of each
-/// 4 x 4 tile (the texture's rows read through a buffer, padded to 256
-/// bytes); and the world itself.
+/// 4 x 4 tile (the texture's rows read through a buffer, padded as a copy
+/// needs); and the world itself.
 fn exports_match(mut w: WorldBox) {
     let gpu = gpu();
     let [nx, ny, _] = w.description().size;
@@ -258,10 +258,12 @@ fn exports_match(mut w: WorldBox) {
     g.record(&mut encoder, 9);
     exports.record(&g, &mut encoder);
     let (tw, th) = (nx.div_ceil(4), ny.div_ceil(4));
-    let texels = gpu.device.create_buffer(&wgpu::BufferDescriptor { label: None, size: 256 * u64::from(th), usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC, mapped_at_creation: false });
+    // Eight bytes a texel (four half floats), rows padded as a copy needs.
+    let row = (8 * tw).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
+    let texels = gpu.device.create_buffer(&wgpu::BufferDescriptor { label: None, size: u64::from(row * th), usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC, mapped_at_creation: false });
     encoder.copy_texture_to_buffer(
         exports.density.as_image_copy(),
-        wgpu::TexelCopyBufferInfo { buffer: &texels, layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(256), rows_per_image: None } },
+        wgpu::TexelCopyBufferInfo { buffer: &texels, layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(row), rows_per_image: None } },
         exports.density.size(),
     );
     gpu.queue.submit([encoder.finish()]);
@@ -281,7 +283,7 @@ fn exports_match(mut w: WorldBox) {
     let texels = gpu.read(&texels);
     for ty in 0..th {
         for tx in 0..tw {
-            let at = (256 * ty + 8 * tx) as usize;
+            let at = (row * ty + 8 * tx) as usize;
             let share = half::f16::from_le_bytes([texels[at], texels[at + 1]]).to_f32();
             let n = cpu.iter().filter(|p| p.pos[0] / 4 == tx && p.pos[1] / 4 == ty).count();
             assert_eq!(share, n as f32 / 16.0, "tile {tx} {ty}");
