@@ -28,6 +28,8 @@ pub use api::query::{Cell, Particle, Particles, RegionStats, Stats};
 pub use api::snapshot::{image_description, IMAGE_VERSION};
 pub use rules::emitter::{Emitter, EmitterStats};
 pub use rules::obstacle::{Shape, Surface};
+#[cfg(feature = "obstacles")]
+pub use api::bodies::BodyStats;
 pub use step::Order;
 #[cfg(target_has_atomic = "8")]
 pub use step::tasks::{Host, MAX_TASKS};

@@ -137,6 +137,10 @@ pub enum mpca_status {
     /// Every particle id of the world's life was given: no particle can be
     /// added, and emitters count what they ask for as shortfall (M6b).
     IdsExhausted = 141,
+    /// Every slot of the body table holds a body (M13).
+    BodyTableFull = 142,
+    /// The id names no body: never given, or its body was removed (M13).
+    NoBody = 143,
     /// An error this version of the C ABI does not know by name.
     Unknown = 199,
 }
@@ -228,7 +232,7 @@ impl mpca_status {
             S::Overlap => c"an image overlaps the memory of its world, or new world memory lies in a world the library allocated",
             S::Unknown => c"an error this version of the C ABI does not name",
             // The statuses of core errors say what core says.
-            S::BadHandle | S::OutputTooSmall | S::BadDimension | S::Dim3Disabled | S::SizeZero | S::SizeOdd | S::TooLarge | S::PeriodicMismatch | S::NotFinite | S::NegativeDt | S::BadVortex | S::BadDrag | S::RestitutionRange | S::MassRange | S::SpeedRange | S::Q16Disabled | S::FeatureDisabled | S::NotEnabled | S::CapacityRange | S::BufferTooSmall | S::OutOfBounds | S::CellOccupied | S::CellObstacle | S::NoParticle | S::MassTableFull | S::SurfaceTableFull | S::UndefinedNormal | S::EmitterTableFull | S::BadEmitter | S::LifetimeRange | S::BadShape | S::BadResolution | S::BadLength | S::NotOwned | S::OutOfMemory | S::NotAnImage | S::ImageVersion | S::ImageLength | S::ImageChecksum | S::ImageInvalid | S::ImageMismatch | S::IdsExhausted => match self.core_error() {
+            S::BadHandle | S::OutputTooSmall | S::BadDimension | S::Dim3Disabled | S::SizeZero | S::SizeOdd | S::TooLarge | S::PeriodicMismatch | S::NotFinite | S::NegativeDt | S::BadVortex | S::BadDrag | S::RestitutionRange | S::MassRange | S::SpeedRange | S::Q16Disabled | S::FeatureDisabled | S::NotEnabled | S::CapacityRange | S::BufferTooSmall | S::OutOfBounds | S::CellOccupied | S::CellObstacle | S::NoParticle | S::MassTableFull | S::SurfaceTableFull | S::UndefinedNormal | S::EmitterTableFull | S::BadEmitter | S::LifetimeRange | S::BadShape | S::BadResolution | S::BadLength | S::NotOwned | S::OutOfMemory | S::NotAnImage | S::ImageVersion | S::ImageLength | S::ImageChecksum | S::ImageInvalid | S::ImageMismatch | S::IdsExhausted | S::BodyTableFull | S::NoBody => match self.core_error() {
                 Some(e) => e.c_message(),
                 None => panic!("a status listed as a core error's has no core error"),
             },
@@ -247,7 +251,7 @@ pub extern "C" fn mpca_status_message(status: u32) -> *const c_char {
 }
 
 /// Every status, for looking one up by number.
-const ALL: [mpca_status; 55] = {
+const ALL: [mpca_status; 57] = {
     use mpca_status as S;
     [
         S::Ok, S::NullPointer, S::BadHandle, S::Panic, S::BadStructSize, S::BadEnum, S::OutputTooSmall, S::NotASurface,
@@ -259,7 +263,7 @@ const ALL: [mpca_status; 55] = {
         S::SurfaceTableFull, S::UndefinedNormal, S::EmitterTableFull, S::BadEmitter, S::LifetimeRange,
         S::BadShape, S::BadResolution, S::BadLength, S::NotOwned, S::OutOfMemory,
         S::NotAnImage, S::ImageVersion, S::ImageLength, S::ImageChecksum, S::ImageInvalid, S::ImageMismatch, S::IdsExhausted,
-        S::Unknown,
+        S::BodyTableFull, S::NoBody, S::Unknown,
     ]
 };
 

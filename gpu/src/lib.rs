@@ -160,8 +160,9 @@ impl Gpu {
 
 /// Why this backend cannot run a description: `None` where it can.
 pub fn unsupported(d: &Description) -> Option<&'static str> {
-    let checks: [(bool, &'static str); 1] = [
+    let checks: [(bool, &'static str); 2] = [
         (d.dim == 2, "3D worlds"),
+        (!(d.obstacles && d.body_capacity > 0), "bodies, obstacles the caller moves (M13)"),
     ];
     checks.iter().find(|(ok, _)| !ok).map(|(_, what)| *what)
 }

@@ -110,6 +110,11 @@ fn a_part_the_backend_does_not_run_is_refused() {
     let w = WorldBox::new(&Description::new_3d(8, 8, 8)).unwrap();
     assert!(matches!(GpuWorld::new(&gpu, &w), Err(mpca_gpu::Error::World(mpca::Error::FeatureDisabled))));
     assert_eq!(mpca_gpu::unsupported(w.description()), Some("3D worlds"));
+    let mut d = Description::new_2d(16, 16);
+    (d.obstacles, d.body_capacity, d.body_surface_capacity) = (true, 1, 64);
+    let w = WorldBox::new(&d).unwrap();
+    assert!(matches!(GpuWorld::new(&gpu, &w), Err(mpca_gpu::Error::World(mpca::Error::FeatureDisabled))));
+    assert_eq!(mpca_gpu::unsupported(w.description()), Some("bodies, obstacles the caller moves (M13)"));
 }
 
 /// A scene of the paper as the paper ran it, compared every `every` steps.

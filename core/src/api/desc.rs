@@ -209,6 +209,13 @@ pub struct Description {
     /// How many obstacle surface cells (with normal and restitution) fit;
     /// [`Description::surface_entries`] says how many a shape takes.
     pub surface_capacity: u32,
+    /// How many bodies, obstacles the caller moves (M13, with `obstacles`),
+    /// fit.
+    pub body_capacity: u32,
+    /// How many body surface cells fit (M13): every body cell with a free
+    /// neighbour takes one; [`Description::surface_entries`] of a body's
+    /// shape is an upper bound for it.
+    pub body_surface_capacity: u32,
     /// Which force terms are summed (M5.1).
     pub forces: Forces,
     /// The uniform acceleration, used when `forces.uniform`, in cells per
@@ -271,6 +278,8 @@ impl Description {
             mass_classes: 1,
             obstacles: false,
             surface_capacity: 0,
+            body_capacity: 0,
+            body_surface_capacity: 0,
             forces: Forces { uniform: false, field: false, potential: false, vortex: false },
             gravity: [0.0; 3],
             vortex: Vortex { centre: [0.0; 2], core_radius: 1.0, circulation: 0.0 },
@@ -404,6 +413,14 @@ impl Description {
     #[inline(always)]
     pub(crate) const fn has_obstacles(&self) -> bool {
         cfg!(feature = "obstacles") && self.obstacles
+    }
+
+    /// Whether the world keeps a body table (M13): obstacles, and room for
+    /// a body.
+    #[cfg(feature = "obstacles")]
+    #[inline(always)]
+    pub(crate) const fn has_bodies(&self) -> bool {
+        self.has_obstacles() && self.body_capacity > 0
     }
 
     /// `forces` with the terms this build leaves out false, as they are by

@@ -109,6 +109,10 @@ pub enum Error {
     /// Every id of the world's life was given: no particle can be added
     /// (M6b).
     IdsExhausted = 141,
+    /// Every slot of the body table holds a body (M13).
+    BodyTableFull = 142,
+    /// The id names no body: never given, or its body was removed (M13).
+    NoBody = 143,
 }
 
 /// The one table of messages. It writes both [`Error::c_message`], whose
@@ -175,6 +179,8 @@ messages! {
     ImageInvalid => c"the image does not hold a consistent world",
     ImageMismatch => c"the image holds a world of another size or layout than this one",
     IdsExhausted => c"every particle id of the world's life was given",
+    BodyTableFull => c"the body table is full",
+    NoBody => c"no body has this id",
 }
 
 impl Error {

@@ -1,6 +1,8 @@
 //! The public API: descriptions and their checks, editing a world,
 //! queries, snapshots and errors.
 
+#[cfg(feature = "obstacles")]
+pub(crate) mod bodies;
 pub(crate) mod checks;
 pub(crate) mod desc;
 pub(crate) mod edit;

@@ -14,7 +14,7 @@ use crate::storage::layout::put_bit;
 use crate::storage::world::World;
 
 /// A set of cells, as a predicate on coordinates.
-type Mask<'a> = &'a dyn Fn([usize; 3]) -> bool;
+pub(crate) type Mask<'a> = &'a dyn Fn([usize; 3]) -> bool;
 
 /// Gives a surface cell's outward normal, unnormalised, given the set of
 /// cells that will be obstacles.
@@ -23,15 +23,15 @@ type NormalFn<'a> = &'a dyn Fn(&Frame, [usize; 3], Mask<'_>) -> [f32; 3];
 /// What M7's surface test reads of a world: its cells per axis, its faces
 /// (M4) and its dimension. A description has them before its world does.
 #[derive(Clone, Copy)]
-struct Frame {
-    n: [usize; 3],
-    boundary: [[Boundary; 2]; 3],
-    dim: usize,
+pub(crate) struct Frame {
+    pub(crate) n: [usize; 3],
+    pub(crate) boundary: [[Boundary; 2]; 3],
+    pub(crate) dim: usize,
 }
 
 impl Frame {
     /// The neighbour of `c` at offset `off`, after the boundary rules (M4).
-    fn beyond(&self, c: [usize; 3], off: [i32; 3]) -> Beyond {
+    pub(crate) fn beyond(&self, c: [usize; 3], off: [i32; 3]) -> Beyond {
         let at = [0, 1, 2].map(|k| c[k] as isize + off[k] as isize);
         resolve(self.n, &self.boundary, at)
     }
@@ -65,7 +65,7 @@ impl Frame {
     /// `obstacle` holds are obstacles. Out of line: every pass of an
     /// addition asks it.
     #[inline(never)]
-    fn is_surface(&self, c: [usize; 3], obstacle: Mask<'_>) -> bool {
+    pub(crate) fn is_surface(&self, c: [usize; 3], obstacle: Mask<'_>) -> bool {
         let mut free = false;
         self.for_neighbours(|off| free |= self.free_after(c, off, obstacle));
         free
@@ -157,8 +157,11 @@ impl Addition<'_> {
 /// The obstacles an [`Addition`] is made to: which cells are obstacles and
 /// which hold particles, the surface table and each cell's index in it.
 struct Before<'a> {
+    /// The static obstacles (M7; a body's cells are free to them, M13).
     obstacle: Mask<'a>,
     occupied: Mask<'a>,
+    /// The cells bodies cover (M13), which a static obstacle may not take.
+    body: Mask<'a>,
     table: &'a [Surface],
     cell: &'a dyn Fn([usize; 3]) -> u32,
 }
@@ -175,6 +178,9 @@ impl Before<'_> {
         a.each(&mut |c| {
             if (self.occupied)(c) {
                 return Err(Error::CellOccupied);
+            }
+            if (self.body)(c) {
+                return Err(Error::CellObstacle);
             }
             if frame.is_surface(c, &after) {
                 normalise((a.normal)(frame, c, &after)).ok_or(Error::UndefinedNormal)?;
@@ -209,7 +215,7 @@ impl Description {
         }
         let frame = Frame { n: l.n, boundary: self.boundary, dim: self.dim as usize };
         let none = |_: [usize; 3]| false;
-        let empty = Before { obstacle: &none, occupied: &none, table: &[], cell: &|_| 0 };
+        let empty = Before { obstacle: &none, occupied: &none, body: &none, table: &[], cell: &|_| 0 };
         // At most the world's cell count, which a u32 holds (`Layout::of`).
         Addition::of_shape(shape, &frame, &mut |a| empty.entries_added(&frame, a)).map(|n| n as u32)
     }
@@ -217,7 +223,7 @@ impl Description {
 
 impl World {
     /// This world's [`Frame`].
-    fn frame(&self) -> Frame {
+    pub(crate) fn frame(&self) -> Frame {
         Frame { n: self.layout().n, boundary: self.head.desc.boundary, dim: self.dim() }
     }
 
@@ -232,8 +238,9 @@ impl World {
         let l = *self.layout();
         let site = |c: [usize; 3]| l.site(c[0], c[1], c[2]);
         let before = Before {
-            obstacle: &|c| self.is_obstacle(site(c)),
+            obstacle: &|c| self.is_static(site(c)),
             occupied: &|c| self.occupied(site(c)),
+            body: &|c| self.is_body(site(c)),
             table: self.surfaces_used(),
             cell: &|c| site(c).cell as u32,
         };
@@ -306,7 +313,7 @@ impl World {
         })?;
         a.each(&mut |c| {
             let w: &World = self;
-            let plane = |q: [usize; 3]| w.is_obstacle(site(q));
+            let plane = |q: [usize; 3]| w.is_static(site(q));
             let cell = site(c).cell as u32;
             let entry = frame
                 .is_surface(c, &plane)
@@ -320,14 +327,14 @@ impl World {
             let mut stale = [[0usize; 3]; 26];
             let mut count = 0;
             let w: &World = self;
-            let _ = frame.for_old_neighbours(a, &|q| w.is_obstacle(site(q)), c, &mut |nb| {
+            let _ = frame.for_old_neighbours(a, &|q| w.is_static(site(q)), c, &mut |nb| {
                 stale[count] = nb;
                 count += 1;
                 Ok(())
             });
             for &nb in &stale[..count] {
                 let w: &World = self;
-                let plane = |q: [usize; 3]| w.is_obstacle(site(q));
+                let plane = |q: [usize; 3]| w.is_static(site(q));
                 let cell = site(nb).cell as u32;
                 let Some(old) = surface_at(w.surfaces_used(), cell).copied() else { continue };
                 if !frame.is_surface(nb, &plane) {
@@ -339,7 +346,13 @@ impl World {
                 }
             }
             Ok(())
-        })
+        })?;
+        // M13: a body cell next to the new cells may have lost its last
+        // free neighbour: the body surface table is made again (it can only
+        // shrink; the body cells stay as they are).
+        #[cfg(feature = "obstacles")]
+        self.refresh_bodies();
+        Ok(())
     }
 
     /// Makes one cell an obstacle with the given outward normal (normalised

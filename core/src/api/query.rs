@@ -42,7 +42,8 @@ pub enum Cell {
 pub struct Stats {
     /// Steps taken.
     pub step: u64,
-    /// Particles now; always `added + emitted - exited - expired - removed`.
+    /// Particles now; always `added + emitted - exited - expired - removed
+    /// - crushed`.
     pub particles: u64,
     /// Particles placed by emitters.
     pub emitted: u64,
@@ -52,6 +53,9 @@ pub struct Stats {
     pub expired: u64,
     /// Particles emitters could not place for lack of room.
     pub emit_shortfall: u64,
+    /// Particles removed by bodies for want of a free cell near them
+    /// (M13).
+    pub crushed: u64,
     /// Total momentum `sum m v`.
     pub momentum: [f64; 3],
     /// Total kinetic energy `sum m |v|^2 / 2`.
@@ -239,6 +243,7 @@ impl World {
             exited: c.exited,
             expired: c.expired,
             emit_shortfall: c.shortfall,
+            crushed: self.crushed(),
             momentum,
             kinetic_energy,
             collisions: c.collisions,

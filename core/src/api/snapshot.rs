@@ -53,9 +53,11 @@ use crate::storage::world::{Counters, World};
 /// The first eight bytes of every image.
 const MAGIC: [u8; 8] = *b"MPCASNAP";
 
-/// The version of the image format this library writes. It reads this one
-/// and version 1, whose emitters carry no counts (they load as zero).
-pub const IMAGE_VERSION: u32 = 2;
+/// The newest version of the image format this library writes: 3 holds a
+/// world with bodies (M13). A world without them is written as version 2,
+/// which older libraries read too. It also reads version 1, whose emitters
+/// carry no counts (they load as zero).
+pub const IMAGE_VERSION: u32 = 3;
 
 /// Magic, version, a reserved word and the image's length.
 const HEAD: usize = 24;
@@ -74,6 +76,21 @@ const SURFACE: usize = 24;
 const EMITTER: usize = 72;
 /// One emitter in an image of version 1: without the two counts.
 const EMITTER_V1: usize = 56;
+/// The bodies' head of an image of version 3, after the description: the
+/// body and body surface capacities, the particles bodies crushed, the
+/// redraws since the last step and a reserved word (M13).
+const BODY_HEAD: usize = 24;
+/// One slot of the body table: kind, restitution, the shape's two points
+/// and radius, the velocity and a reserved word, then the tally of the
+/// step under way and the last one (3 momenta, 3 counts and a reserved
+/// word each).
+const BODY: usize = 132;
+
+/// The bytes a world of description `d` keeps of its bodies in an image:
+/// the head and every slot of the table, or nothing without bodies.
+fn body_bytes(d: &Description) -> usize {
+    if d.obstacles && d.body_capacity > 0 { BODY_HEAD + d.body_capacity as usize * BODY } else { 0 }
+}
 
 /// CRC-32 as zlib, PNG and Ethernet compute it: the reflected polynomial
 /// 0xEDB88320, register preset to all ones and inverted at the end. A table
@@ -241,6 +258,7 @@ fn image_len(d: &Description, l: &Layout, particles: usize, masses: usize, surfa
         + usize::from(ids.tags());
     [
         FIXED,
+        body_bytes(d),
         l.occupancy().len,
         l.obstacle().len,
         particles.checked_mul(per_particle)?,
@@ -268,6 +286,9 @@ fn put_desc(p: &mut Put<'_>, d: &Description) {
         mass_classes,
         obstacles,
         surface_capacity,
+        // In the bodies' head of version 3 (M13).
+        body_capacity: _,
+        body_surface_capacity: _,
         forces,
         gravity,
         vortex,
@@ -380,6 +401,8 @@ fn get_desc(g: &mut Get<'_>) -> Result<Description, Error> {
         mass_classes,
         obstacles,
         surface_capacity,
+        body_capacity: 0,
+        body_surface_capacity: 0,
         forces,
         gravity,
         vortex,
@@ -476,6 +499,13 @@ struct Image<'a> {
     mass_table: &'a [u8],
     surface: &'a [u8],
     emitter: &'a [u8],
+    /// M13: the bodies' head, and the body table's slots.
+    #[cfg_attr(not(feature = "obstacles"), allow(dead_code))]
+    crushed: u64,
+    #[cfg_attr(not(feature = "obstacles"), allow(dead_code))]
+    redraws: u32,
+    #[cfg_attr(not(feature = "obstacles"), allow(dead_code))]
+    body: &'a [u8],
 }
 
 /// Checks an image in full and returns it, or the first reason it is
@@ -494,9 +524,10 @@ fn read(image: &[u8]) -> Result<Image<'_>, Error> {
         return Err(Error::ImageLength);
     }
     let mut g = Get { rest: &image[MAGIC.len()..] };
-    let emitter_len = match g.u32()? {
+    let version = g.u32()?;
+    let emitter_len = match version {
         1 => EMITTER_V1,
-        IMAGE_VERSION => EMITTER,
+        2 | 3 => EMITTER,
         _ => return Err(Error::ImageVersion),
     };
     let reserved = g.u32()?;
@@ -513,7 +544,16 @@ fn read(image: &[u8]) -> Result<Image<'_>, Error> {
     if reserved != 0 || image.len() < FIXED + CHECKSUM {
         return Err(bad);
     }
-    let desc = get_desc(&mut g)?;
+    let mut desc = get_desc(&mut g)?;
+    // M13: version 3 is a world with bodies, and only such a world.
+    let (mut crushed, mut redraws) = (0, 0);
+    if version == 3 {
+        (desc.body_capacity, desc.body_surface_capacity, crushed, redraws) = (g.u32()?, g.u32()?, g.u64()?, g.u32()?);
+        g.zeros(4)?;
+        if !desc.obstacles || desc.body_capacity == 0 {
+            return Err(bad);
+        }
+    }
     let layout = desc.plan().map_err(|e| match e {
         Error::Dim3Disabled | Error::Q16Disabled | Error::FeatureDisabled | Error::TooLarge => e,
         _ => bad,
@@ -574,6 +614,9 @@ fn read(image: &[u8]) -> Result<Image<'_>, Error> {
         mass_table: g.take(4 * masses)?,
         surface: g.take(SURFACE * surfaces)?,
         emitter: g.take(emitter_len * emitters)?,
+        crushed,
+        redraws,
+        body: g.take(body_bytes(&desc).saturating_sub(BODY_HEAD))?,
     };
     check(&img)?;
     Ok(img)
@@ -673,6 +716,9 @@ fn check(img: &Image<'_>) -> Result<(), Error> {
         }
     }
 
+    #[cfg(feature = "obstacles")]
+    check_bodies(img)?;
+
     // Emitters: what add_emitter accepts, stored as it stores them.
     for b in img.emitter.chunks_exact(img.emitter_len) {
         let s = get_slot(b);
@@ -695,6 +741,48 @@ fn check(img: &Image<'_>) -> Result<(), Error> {
         if !known {
             return bad;
         }
+    }
+    Ok(())
+}
+
+/// The body table of an image (M13): every slot a body `add_body` could
+/// have made, or zeros; no particle in a cell a body covers, and room in
+/// the body surface table for the bodies' entries.
+#[cfg(feature = "obstacles")]
+fn check_bodies(img: &Image<'_>) -> Result<(), Error> {
+    let bad = Err(Error::ImageInvalid);
+    let (d, l) = (&img.desc, &img.layout);
+    let dim = d.dim as usize;
+    let slots = img.body.len() / BODY;
+    for b in img.body.chunks_exact(BODY) {
+        let body = get_body(b);
+        let Some(shape) = body.shape() else {
+            if b.iter().any(|&x| x != 0) {
+                return bad;
+            }
+            continue;
+        };
+        // As the library stores a body it accepts: the same bits.
+        let Ok(stored) = crate::rules::body::Body::new(shape, body.velocity, body.restitution, dim) else { return bad };
+        let same = |x: &[f32], y: &[f32]| x.iter().zip(y).all(|(a, b)| a.to_bits() == b.to_bits());
+        let fields = |b: &crate::rules::body::Body| [b.a, b.b, b.velocity, [b.radius, b.restitution, 0.0]];
+        // The reserved words: after the velocity and after each tally.
+        let reserved = [12, 22, 32].iter().any(|&w| le_u32(b, w) != 0);
+        if stored.kind != body.kind || !fields(&stored).iter().zip(&fields(&body)).all(|(x, y)| same(x, y)) || reserved {
+            return bad;
+        }
+    }
+    let obstacle = |c: [usize; 3]| {
+        let bit = (c[1] + l.n[1] * c[2]) * l.row_words * 64 + c[0];
+        le_u64(img.obstacle, bit / 64) >> (bit % 64) & 1 != 0
+    };
+    let body = |i: usize| get_body(&img.body[i * BODY..]);
+    let frame = crate::api::obstacles::Frame { n: l.n, boundary: d.boundary, dim };
+    let draw = crate::api::bodies::Draw { frame, count: slots, body: &body, is_static: &obstacle };
+    let mut inside = false;
+    each_bit(l, |k| le_u64(img.occupancy, k), |row, x| inside |= draw.owner([x, row % l.n[1], row / l.n[1]]).is_some());
+    if inside || draw.entries() > d.body_surface_capacity as usize {
+        return bad;
     }
     Ok(())
 }
@@ -784,6 +872,53 @@ fn apply(w: &mut World, img: &Image<'_>) {
             *s = get_slot(b);
         }
     }
+    // M13: the bodies, drawn again over the static obstacles the image
+    // holds (the cells and entries they had).
+    #[cfg(feature = "obstacles")]
+    w.set_bodies(img.crushed, img.redraws, &|i| get_body(&img.body[i * BODY..]));
+}
+
+/// Writes a body table slot (M13) as [`BODY`] bytes.
+#[cfg(feature = "obstacles")]
+fn put_body(p: &mut Put<'_>, b: &crate::rules::body::Body) {
+    p.u32(b.kind);
+    p.f32(b.restitution);
+    b.a.iter().chain(&b.b).for_each(|&c| p.f32(c));
+    p.f32(b.radius);
+    b.velocity.iter().for_each(|&c| p.f32(c));
+    p.u32(0);
+    for t in [&b.current, &b.last] {
+        t.momentum.iter().for_each(|&m| p.u64(m as u64));
+        for c in [t.reflected, t.pushed, t.crushed, 0] {
+            p.u32(c);
+        }
+    }
+}
+
+/// Reads a body table slot written by [`put_body`] (its velocity in fine
+/// units is the world's to convert).
+#[cfg(feature = "obstacles")]
+fn get_body(b: &[u8]) -> crate::rules::body::Body {
+    use crate::rules::body::{Body, Tally};
+    let f = |i| f32::from_bits(le_u32(b, i));
+    let tally = |w: usize| Tally {
+        momentum: [0, 1, 2].map(|k| le_u64(&b[4 * w..], k) as i64),
+        reflected: le_u32(b, w + 6),
+        pushed: le_u32(b, w + 7),
+        crushed: le_u32(b, w + 8),
+        spare: 0,
+    };
+    Body {
+        kind: le_u32(b, 0),
+        restitution: f(1),
+        a: [f(2), f(3), f(4)],
+        b: [f(5), f(6), f(7)],
+        radius: f(8),
+        velocity: [f(9), f(10), f(11)],
+        current: tally(13),
+        last: tally(23),
+        ..Body::ZERO
+    }
 }
 
 /// The set bits of `words`: the particles of an occupancy plane. Out of
@@ -812,7 +947,7 @@ impl World {
         let h = &self.head;
         let occupancy: &[u64] = self.plane(h.layout.occupancy());
         let particles = ones(occupancy);
-        image_len(&h.desc, &h.layout, particles, h.masses as usize, h.surfaces as usize, (h.emitters as usize, EMITTER)).unwrap_or(usize::MAX)
+        image_len(&self.saved_desc(), &h.layout, particles, h.masses as usize, h.surfaces as usize, (h.emitters as usize, EMITTER)).unwrap_or(usize::MAX)
     }
 
     /// Writes the world's image (M12) to the start of `out` and returns its
@@ -826,10 +961,19 @@ impl World {
         let dim = self.dim();
         let mut p = Put { out, at: 0 };
         p.bytes(&MAGIC);
-        p.u32(IMAGE_VERSION);
+        let bodies = body_bytes(&self.saved_desc()) > 0;
+        p.u32(if bodies { 3 } else { 2 });
         p.u32(0);
         p.u64(len as u64);
         put_desc(&mut p, &h.desc);
+        #[cfg(feature = "obstacles")]
+        if let Some((crushed, redraws)) = self.body_head() {
+            p.u32(h.desc.body_capacity);
+            p.u32(h.desc.body_surface_capacity);
+            p.u64(crushed);
+            p.u32(redraws);
+            p.u32(0);
+        }
         p.u64(h.step);
         let Counters { particles, emitted, exited, expired, shortfall, collisions, clamps, clamp_energy, displaced, processed, skipped } =
             h.counters;
@@ -845,7 +989,12 @@ impl World {
         }
         let occupancy: &[u64] = self.plane(l.occupancy());
         occupancy.iter().for_each(|&w| p.u64(w));
-        self.plane::<u64>(l.obstacle()).iter().for_each(|&w| p.u64(w));
+        // The static obstacles: bodies are drawn again from their table
+        // when the image is loaded (M13).
+        let obstacle: &[u64] = self.plane(l.obstacle());
+        for (i, &w) in obstacle.iter().enumerate() {
+            p.u64(w & !self.body_word(i));
+        }
         // Per particle, in cell order: velocities, mass classes, lifetimes,
         // then ids, ages and tags.
         let each_particle = |f: &mut dyn FnMut(usize)| each_cell(&l, occupancy, f);
@@ -883,10 +1032,22 @@ impl World {
         self.plane::<f32>(l.mass_table())[..h.masses as usize].iter().for_each(|&m| p.f32(m));
         self.plane::<Surface>(l.surface())[..h.surfaces as usize].iter().for_each(|s| put_surface(&mut p, s));
         self.plane::<Slot>(l.emitters())[..h.emitters as usize].iter().for_each(|s| put_slot(&mut p, s));
+        #[cfg(feature = "obstacles")]
+        self.each_body(&mut |b| put_body(&mut p, b));
         let crc = crc32(&p.out[..len - CHECKSUM]);
         p.u32(crc);
         debug_assert_eq!(p.at, len);
         Ok(len)
+    }
+
+    /// The description as an image keeps it: without body capacities
+    /// where the build has no bodies.
+    fn saved_desc(&self) -> Description {
+        let mut d = self.head.desc;
+        if !cfg!(feature = "obstacles") {
+            (d.body_capacity, d.body_surface_capacity) = (0, 0);
+        }
+        d
     }
 
     /// Makes this world the one `image` holds (M12): its description,

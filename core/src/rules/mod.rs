@@ -2,6 +2,8 @@
 //! particles of a block, independent of where a world keeps them.
 
 pub mod assign;
+#[cfg(feature = "obstacles")]
+pub(crate) mod body;
 pub(crate) mod class;
 pub(crate) mod collision;
 pub(crate) mod emitter;

@@ -66,6 +66,16 @@ pub enum Shape {
         /// Radius, greater than zero.
         radius: f32,
     },
+    /// The points within `radius` of the segment from `a` to `b` (a disc
+    /// or sphere where `a = b`); in 2D only x and y count.
+    Capsule {
+        /// One end of the segment.
+        a: [f32; 3],
+        /// The other end.
+        b: [f32; 3],
+        /// Radius, greater than zero.
+        radius: f32,
+    },
 }
 
 /// Eq. 9 in fine units (M1c): `v' = v - (1 + e)(N.v)N` with the normal
@@ -123,6 +133,7 @@ impl Shape {
     pub(crate) fn in_dim(self, dim: usize) -> Shape {
         match self {
             Shape::HalfSpace { point, normal } => Shape::HalfSpace { point, normal: in_plane(normal, dim) },
+            Shape::Capsule { a, b, radius } => Shape::Capsule { a: in_plane(a, dim), b: in_plane(b, dim), radius },
             other => other,
         }
     }
@@ -161,6 +172,14 @@ impl Shape {
                     return Err(Error::BadShape);
                 }
             }
+            Shape::Capsule { a, b, radius } => {
+                finite(&a)?;
+                finite(&b)?;
+                finite(&[radius])?;
+                if radius <= 0.0 {
+                    return Err(Error::BadShape);
+                }
+            }
         }
         Ok(())
     }
@@ -183,7 +202,25 @@ impl Shape {
                 let d = [c[0] - centre[0], c[1] - centre[1], c[2] - centre[2]];
                 dot(d, d) <= radius * radius
             }
+            Shape::Capsule { radius, .. } => {
+                let d = self.off_axis(c, dim);
+                dot(d, d) <= radius * radius
+            }
         }
+    }
+
+    /// For a capsule, `c` less the point of its segment nearest to `c`
+    /// (in the world's `dim` axes); zero for every other shape.
+    fn off_axis(&self, c: [f32; 3], dim: usize) -> [f32; 3] {
+        let Shape::Capsule { a, b, .. } = *self else { return [0.0; 3] };
+        let (mut ab, mut ac) = ([0.0f32; 3], [0.0f32; 3]);
+        for k in 0..dim {
+            ab[k] = b[k] - a[k];
+            ac[k] = c[k] - a[k];
+        }
+        let len2 = dot(ab, ab);
+        let t = if len2 > 0.0 { (dot(ac, ab) / len2).clamp(0.0, 1.0) } else { 0.0 };
+        [0, 1, 2].map(|k| ac[k] - t * ab[k])
     }
 
     /// The outward normal at a cell centre inside the shape (not normalised;
@@ -211,6 +248,7 @@ impl Shape {
             }
             Shape::Disc { centre, .. } => [c[0] - centre[0], c[1] - centre[1], 0.0],
             Shape::Sphere { centre, .. } => [c[0] - centre[0], c[1] - centre[1], c[2] - centre[2]],
+            Shape::Capsule { .. } => self.off_axis(c, dim),
         }
     }
 
@@ -223,6 +261,9 @@ impl Shape {
                 ([centre[0] - radius, centre[1] - radius, 0.0], [centre[0] + radius, centre[1] + radius, 1.0])
             }
             Shape::Sphere { centre, radius } => (centre.map(|c| c - radius), centre.map(|c| c + radius)),
+            Shape::Capsule { a, b, radius } => {
+                ([0, 1, 2].map(|k| a[k].min(b[k]) - radius), [0, 1, 2].map(|k| a[k].max(b[k]) + radius))
+            }
         };
         // Axes the world does not have span their single cell.
         let mut a = [0usize; 3];

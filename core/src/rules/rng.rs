@@ -27,6 +27,9 @@
 /// where a block index equals an emitter index.
 const DOMAIN_BLOCK: u64 = 0x6d70_6361_626c_6b00; // "mpcablk"
 const DOMAIN_EMITTER: u64 = 0x6d70_6361_656d_6900; // "mpcaemi"
+/// The push-outs of M13's body moves.
+#[cfg(feature = "obstacles")]
+const DOMAIN_BODY: u64 = 0x6d70_6361_6264_7900; // "mpcabdy"
 
 /// Block `b` owns counters `b 2^16 + 1 ..= b 2^16 + 2^16`.
 const BLOCK_WINDOW: u32 = 16;
@@ -78,6 +81,13 @@ impl StepKey {
     /// The emitter streams of `step`.
     pub fn emitters(seed: u64, step: u64) -> StepKey {
         StepKey::derive(seed, step, DOMAIN_EMITTER, EMITTER_WINDOW)
+    }
+
+    /// The push-out streams of the body moves before `step` (M13): one
+    /// per cell and redraw, each needing one output.
+    #[cfg(feature = "obstacles")]
+    pub(crate) fn bodies(seed: u64, step: u64) -> StepKey {
+        StepKey::derive(seed, step, DOMAIN_BODY, 1)
     }
 
     /// The stream of block (or emitter) `index`.

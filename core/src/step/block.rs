@@ -221,6 +221,21 @@ pub(crate) struct Shared<'a> {
     /// `identity` (firmware), whose setup would store it for nothing.
     #[cfg(feature = "identity")]
     pub identity: Identified<'a>,
+    /// The bodies (M13): empty in a world without them.
+    #[cfg(feature = "obstacles")]
+    pub bodies: Moving<'a>,
+}
+
+/// What the step reads of the bodies (M13), and the tallies its
+/// reflections write, one per body surface entry: a block writes only the
+/// entries of its own cells, so blocks on different threads never write
+/// the same one.
+#[cfg(feature = "obstacles")]
+#[derive(Clone, Copy)]
+pub(crate) struct Moving<'a> {
+    pub surface: &'a [crate::rules::body::BodySurface],
+    pub table: &'a [crate::rules::body::Body],
+    pub tally: Cells<'a, crate::rules::body::CellTally>,
 }
 
 /// The planes a step writes; `velocity` holds a cell's `D` components

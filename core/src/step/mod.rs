@@ -169,6 +169,8 @@ impl World {
                 _ => run::<Q, 2, 4>(self, route, split),
             }
         });
+        #[cfg(feature = "obstacles")]
+        self.end_body_step();
         // An image may carry any step number (M12): after 2^64 - 1 the
         // count wraps to 0 (the parity of M3 goes on alternating).
         self.head.step = self.head.step.wrapping_add(1);
@@ -213,6 +215,12 @@ impl World {
         // together.
         let (desc, counters) = (&head.desc, &mut head.counters);
         let Layout { n, .. } = head.layout;
+        #[cfg(feature = "obstacles")]
+        let bodies = {
+            let (head, table) = crate::storage::layout::head_and_bodies(p.bodies);
+            let used = head.map_or(0, |h| h.surfaces as usize);
+            crate::step::block::Moving { surface: &p.body_surface[..used], table, tally: Cells::new(&mut p.body_tally[..used]) }
+        };
         let Planes { occupancy, rows, words, obstacle, velocity, mass_index, life, field, potential, wind, mass_table, surface, .. } = p;
         let forces = desc.built_forces();
         // M1c: every setting converted once, here, by integer arithmetic on
@@ -290,6 +298,8 @@ impl World {
             lanes: plain && !desc.has_contacts(),
             #[cfg(feature = "identity")]
             identity: Identified { id: Cells::new(p.id), age: Cells::new(p.age), tag: Cells::new(p.tag) },
+            #[cfg(feature = "obstacles")]
+            bodies,
         };
         Setup {
             counters,

@@ -7,6 +7,9 @@ use crate::api::desc::Boundary;
 use crate::rules::collision::WIDEST;
 use crate::rules::faces::{resolve, Beyond, Coords};
 use crate::rules::fixed::scaled;
+#[cfg(feature = "obstacles")]
+use crate::rules::body::{body_surface_at, CellTally, Tally};
+use crate::rules::fixed::sat;
 use crate::rules::obstacle::{axis_q30, dot_q30, normal_q30, reflect, surface_at, Surface};
 use crate::rules::class::Class;
 use crate::rules::quant::Quant;
@@ -83,11 +86,24 @@ pub(crate) fn reflect_off(sh: &Shared<'_>, mut x: [i32; 3], c: usize, to: Wanted
     // A build without obstacles has no surface entry and no obstacle
     // cell (here and below), and no code to look either up.
     let table: &[Surface] = if cfg!(feature = "obstacles") { sh.surface } else { &[] };
-    let (n, e) = surface.unwrap_or_else(|| match surface_at(table, site as u32) {
-        // Component by component: a copy of the array through the
-        // reference is a `memmove` call at opt-level z, the only one in a
-        // firmware build.
-        Some(s) => (normal_q30([s.normal[0], s.normal[1], s.normal[2]]), s.restitution),
+    // Component by component: a copy of the array through the reference
+    // is a `memmove` call at opt-level z, the only one in a firmware build.
+    let fixed = surface.or_else(|| surface_at(table, site as u32).map(|s| (normal_q30([s.normal[0], s.normal[1], s.normal[2]]), s.restitution)));
+    // M13: a body cell's entry, with its index and its body's velocity
+    // `U`; eq. 9 then acts on the velocity relative to the surface,
+    // `w = v - U`, and every test below reads `w` (a static surface is a
+    // body at rest).
+    #[cfg(feature = "obstacles")]
+    let moving = if fixed.is_none() { moving_surface(sh, site) } else { None };
+    #[cfg(not(feature = "obstacles"))]
+    let moving: Option<(usize, [i32; 3], [i32; 3], f32)> = None;
+    let (v, u) = (x, moving.map_or([0; 3], |(_, u, _, _)| u));
+    if moving.is_some() {
+        // Both within the saturation bound: the difference fits.
+        x = [0, 1, 2].map(|k| x[k] - u[k]);
+    }
+    let (n, e) = match fixed.or(moving.map(|(_, _, n, e)| (n, e))) {
+        Some(surface) => surface,
         // Unreachable for obstacles added through the API (every cell
         // next to a free one has an entry): the direction back to the
         // particle.
@@ -97,7 +113,7 @@ pub(crate) fn reflect_off(sh: &Shared<'_>, mut x: [i32; 3], c: usize, to: Wanted
         // of 0 would reflect nothing; the build holds no code for the
         // direction back.
         None => ([0; 3], sh.desc.wall_restitution),
-    });
+    };
     // Without obstacles only cells beyond a wall face are blocked, and a
     // particle asks for one only moving towards it (M5.3: every axis it
     // crosses points out of the domain), so N.v < 0: a build without
@@ -126,8 +142,31 @@ pub(crate) fn reflect_off(sh: &Shared<'_>, mut x: [i32; 3], c: usize, to: Wanted
         back
     };
     let mut x = reflect(x, n, scaled(e, 1.0, 16) as i32); // eq. 9
+    if moving.is_some() {
+        x = [0, 1, 2].map(|k| sat(i64::from(u[k]) + i64::from(x[k])));
+    }
     clamp_counted::<WIDEST>(&mut x, unit, class, counters);
+    // M13: what the body gave the particle, tallied in the entry's cell.
+    #[cfg(feature = "obstacles")]
+    if let Some((i, ..)) = moving {
+        let t = sh.bodies.tally.get(i);
+        let mut tally = Tally { momentum: t.momentum, reflected: t.reflected.wrapping_add(1), ..Tally::default() };
+        tally.add_change(class.relative, [0, 1, 2].map(|k| x[k] - v[k]));
+        sh.bodies.tally.set(i, CellTally { momentum: tally.momentum, reflected: tally.reflected, spare: 0 });
+    }
+    #[cfg(not(feature = "obstacles"))]
+    let _ = v;
     Some(x)
+}
+
+/// The body surface entry of cell `site` (M13), where it is a body's: its
+/// index, the body's velocity in fine units, the normal in Q30 and the
+/// restitution.
+#[cfg(feature = "obstacles")]
+fn moving_surface(sh: &Shared<'_>, site: usize) -> Option<(usize, [i32; 3], [i32; 3], f32)> {
+    let (i, s) = body_surface_at(sh.bodies.surface, site as u32)?;
+    let u = sh.bodies.table.get(s.body as usize).map_or([0; 3], |b| b.fine);
+    Some((i, u, normal_q30([s.normal[0], s.normal[1], s.normal[2]]), s.restitution))
 }
 
 /// M5.4: whether the particle at `at` (raw coordinates, resolved across the

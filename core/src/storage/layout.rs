@@ -10,6 +10,8 @@ use crate::Error;
 use crate::api::desc::{Checked, Description, Quantization};
 use crate::rules::emitter::Slot;
 use crate::rules::obstacle::Surface;
+#[cfg(feature = "obstacles")]
+use crate::rules::body::{Body, BodiesHead, BodySurface, CellTally};
 use crate::rules::class::Class;
 use crate::storage::cells::Cells;
 use crate::storage::plain::Plain;
@@ -18,6 +20,20 @@ use crate::storage::plain::Plain;
 unsafe impl Plain for Surface {}
 // SAFETY: u32 and f32 fields only, no padding, every bit pattern valid.
 unsafe impl Plain for Slot {}
+// SAFETY: u32 and f32 fields only, no padding, every bit pattern valid.
+#[cfg(feature = "obstacles")]
+unsafe impl Plain for BodySurface {}
+// SAFETY: u32, f32 and i32 fields, then two tallies of i64 and u32 fields
+// (`repr(C)`, 8-aligned at an offset of 64), no padding, every bit pattern
+// valid.
+#[cfg(feature = "obstacles")]
+unsafe impl Plain for Body {}
+// SAFETY: i64 and u32 fields, no padding, every bit pattern valid.
+#[cfg(feature = "obstacles")]
+unsafe impl Plain for BodiesHead {}
+// SAFETY: i64 and u32 fields, no padding, every bit pattern valid.
+#[cfg(feature = "obstacles")]
+unsafe impl Plain for CellTally {}
 // SAFETY: f32, u32, f32, u32 and i64 fields in that order (`repr(C)`), no
 // padding, every bit pattern valid.
 unsafe impl Plain for Class {}
@@ -121,9 +137,12 @@ pub(crate) struct Layout {
 
 /// The planes every build plans, the getters of `planes!` below.
 const BASE_PLANES: usize = 13;
-/// The number of planes of a [`Layout`]: the identity planes (M6b), last,
-/// only in a build with `identity`, so firmware without it plans as before.
-const PLANES: usize = BASE_PLANES + if cfg!(feature = "identity") { 3 } else { 0 };
+/// The identity planes (M6b), after the base ones, only in a build with
+/// `identity`, so firmware without it plans as before.
+const IDENTITY_PLANES: usize = if cfg!(feature = "identity") { 3 } else { 0 };
+/// The number of planes of a [`Layout`]: then M13's, last, only in a build
+/// with `obstacles`.
+const PLANES: usize = BASE_PLANES + IDENTITY_PLANES + if cfg!(feature = "obstacles") { 4 } else { 0 };
 
 /// A getter for each plane of a [`Layout`], by its index in `plane`.
 macro_rules! planes {
@@ -181,6 +200,36 @@ impl Layout {
     pub(crate) fn tag(&self) -> Plane {
         self.identity_plane(2)
     }
+
+    /// M13's planes: empty in a build without `obstacles`.
+    #[cfg(feature = "obstacles")]
+    #[inline]
+    fn body_plane(&self, i: usize) -> Plane {
+        self.plane.get(BASE_PLANES + IDENTITY_PLANES + i).copied().unwrap_or_default()
+    }
+    /// One bit per cell: whether a body covers it (the obstacle plane
+    /// holds these cells too).
+    #[cfg(feature = "obstacles")]
+    #[inline]
+    pub(crate) fn body_cells(&self) -> Plane {
+        self.body_plane(0)
+    }
+    /// A [`BodiesHead`], then the body table.
+    #[cfg(feature = "obstacles")]
+    #[inline]
+    pub(crate) fn bodies(&self) -> Plane {
+        self.body_plane(1)
+    }
+    #[cfg(feature = "obstacles")]
+    #[inline]
+    pub(crate) fn body_surface(&self) -> Plane {
+        self.body_plane(2)
+    }
+    #[cfg(feature = "obstacles")]
+    #[inline]
+    pub(crate) fn body_tally(&self) -> Plane {
+        self.body_plane(3)
+    }
 }
 
 impl Layout {
@@ -213,6 +262,15 @@ impl Layout {
         // `bytes` a cell where `on`.
         let per_cell = |bytes: usize, on: bool| mul(cells, bytes * usize::from(on));
         let summary_words = row_words.div_ceil(64);
+        // M13's planes: the cells bodies cover, the body table after its
+        // head, the body surface table and a step's tally per entry.
+        #[cfg(feature = "obstacles")]
+        let body = if d.has_bodies() {
+            let entries = d.body_surface_capacity as usize;
+            [bit_plane, mul(d.body_capacity as usize, size_of::<Body>())? + size_of::<BodiesHead>(), mul(entries, size_of::<BodySurface>())?, mul(entries, size_of::<CellTally>())?]
+        } else {
+            [0; 4]
+        };
         // The planes' lengths in the order they lie in memory, each
         // starting 8-byte aligned after the one before; M6b's last, and
         // only in a build with `identity` (a build without refuses them,
@@ -237,6 +295,15 @@ impl Layout {
             per_cell(4, d.identity.ages())?,
             #[cfg(feature = "identity")]
             per_cell(1, d.identity.tags())?,
+            // M13's, last, only in a build with `obstacles`.
+            #[cfg(feature = "obstacles")]
+            body[0],
+            #[cfg(feature = "obstacles")]
+            body[1],
+            #[cfg(feature = "obstacles")]
+            body[2],
+            #[cfg(feature = "obstacles")]
+            body[3],
         ];
         let mut plane = lens.map(|len| Plane { off: 0, len });
         let mut at = 0usize;
@@ -322,6 +389,26 @@ pub(crate) struct Planes<'a, Q> {
     pub mass_table: &'a mut [f32],
     pub surface: &'a mut [Surface],
     pub emitters: &'a mut [Slot],
+    /// M13's planes, in a build with `obstacles` alone.
+    #[cfg(feature = "obstacles")]
+    pub body_cells: &'a mut [u64],
+    #[cfg(feature = "obstacles")]
+    pub bodies: &'a mut [u8],
+    #[cfg(feature = "obstacles")]
+    pub body_surface: &'a mut [BodySurface],
+    #[cfg(feature = "obstacles")]
+    pub body_tally: &'a mut [CellTally],
+}
+
+/// The body table's plane split into its head and its slots (M13); an
+/// empty plane (no bodies) gives none.
+#[cfg(feature = "obstacles")]
+pub(crate) fn head_and_bodies(plane: &mut [u8]) -> (Option<&mut BodiesHead>, &mut [Body]) {
+    if plane.len() < size_of::<BodiesHead>() {
+        return (None, &mut []);
+    }
+    let (head, table) = plane.split_at_mut(size_of::<BodiesHead>());
+    (view::<BodiesHead>(head).first_mut(), view(table))
 }
 
 /// Where a cell lives in the planes.

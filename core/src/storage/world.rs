@@ -259,6 +259,14 @@ impl World {
             age: p.age,
             #[cfg(feature = "identity")]
             tag: p.tag,
+            #[cfg(feature = "obstacles")]
+            body_cells: p.body_cells,
+            #[cfg(feature = "obstacles")]
+            bodies: p.bodies,
+            #[cfg(feature = "obstacles")]
+            body_surface: p.body_surface,
+            #[cfg(feature = "obstacles")]
+            body_tally: p.body_tally,
         };
         (head, planes)
     }
@@ -304,6 +312,15 @@ impl World {
             age: view(take(l.age())),
             #[cfg(feature = "identity")]
             tag: take(l.tag()),
+            // M13's, after them.
+            #[cfg(feature = "obstacles")]
+            body_cells: view(take(l.body_cells())),
+            #[cfg(feature = "obstacles")]
+            bodies: take(l.bodies()),
+            #[cfg(feature = "obstacles")]
+            body_surface: view(take(l.body_surface())),
+            #[cfg(feature = "obstacles")]
+            body_tally: view(take(l.body_tally())),
         };
         (&mut self.head, planes)
     }
@@ -339,6 +356,40 @@ impl World {
     /// Whether cell `s` is an obstacle: never in a build without obstacles.
     pub(crate) fn is_obstacle(&self, s: Site) -> bool {
         cfg!(feature = "obstacles") && test_bit(self.plane(self.layout().obstacle()), s.bit)
+    }
+
+    /// Whether a body covers cell `s` (M13): never without bodies.
+    pub(crate) fn is_body(&self, s: Site) -> bool {
+        #[cfg(feature = "obstacles")]
+        if self.head.desc.has_bodies() {
+            return test_bit(self.plane(self.layout().body_cells()), s.bit);
+        }
+        let _ = s;
+        false
+    }
+
+    /// Particles bodies crushed (M13): none without bodies.
+    pub(crate) fn crushed(&self) -> u64 {
+        #[cfg(feature = "obstacles")]
+        return self.crushed_count();
+        #[cfg(not(feature = "obstacles"))]
+        0
+    }
+
+    /// Word `i` of the plane of cells bodies cover (M13): 0 without bodies.
+    pub(crate) fn body_word(&self, i: usize) -> u64 {
+        #[cfg(feature = "obstacles")]
+        return self.body_word_of(i);
+        #[cfg(not(feature = "obstacles"))]
+        {
+            let _ = i;
+            0
+        }
+    }
+
+    /// Whether cell `s` is a static obstacle (M7), not a body's (M13).
+    pub(crate) fn is_static(&self, s: Site) -> bool {
+        self.is_obstacle(s) && !self.is_body(s)
     }
 
     /// The emitter table, as long as its capacity.

@@ -1,0 +1,205 @@
+//! Kinematic obstacles (M13): bodies the caller moves, what the world keeps
+//! of each, and the two rules that read a body's velocity: the push-out of
+//! a particle a body takes, and eq. 9 in the frame of a moving surface.
+
+use crate::Error;
+use crate::api::checks::{finite, restitution};
+use crate::rules::obstacle::{dot_q30, Shape};
+use crate::rules::fixed::sat;
+
+/// What a body exchanged with the particles: momentum in the body's
+/// integers (M13: each particle's relative mass, 24 bits, times its change
+/// of velocity in fine units, summed wrapping), and counts. A body keeps
+/// the tally of the step under way and the last finished one.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[repr(C)]
+pub(crate) struct Tally {
+    pub momentum: [i64; 3],
+    pub reflected: u32,
+    pub pushed: u32,
+    pub crushed: u32,
+    pub spare: u32,
+}
+
+impl Tally {
+    const ZERO: Tally = Tally { momentum: [0; 3], reflected: 0, pushed: 0, crushed: 0, spare: 0 };
+
+    /// Adds a change of velocity `dv` (fine units) of a particle of
+    /// relative mass `relative` to the momentum.
+    pub(crate) fn add_change(&mut self, relative: u32, dv: [i32; 3]) {
+        for k in 0..3 {
+            self.momentum[k] = self.momentum[k].wrapping_add(i64::from(relative) * i64::from(dv[k]));
+        }
+    }
+
+    /// Adds another tally, wrapping: sums in any order are the same.
+    pub(crate) fn add(&mut self, o: &Tally) {
+        for k in 0..3 {
+            self.momentum[k] = self.momentum[k].wrapping_add(o.momentum[k]);
+        }
+        self.reflected = self.reflected.wrapping_add(o.reflected);
+        self.pushed = self.pushed.wrapping_add(o.pushed);
+        self.crushed = self.crushed.wrapping_add(o.crushed);
+    }
+}
+
+/// What a step's reflections off one body surface cell add up to: kept
+/// per entry of the body surface table, which one block at most touches
+/// in a step (a particle asks only for cells of its own block), so blocks
+/// on any thread add to them without atomics; the step's end gathers them
+/// into their bodies.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[repr(C)]
+pub(crate) struct CellTally {
+    pub momentum: [i64; 3],
+    pub reflected: u32,
+    pub spare: u32,
+}
+
+/// One body surface cell (M13): as a static [`Surface`](crate::rules::obstacle::Surface),
+/// with the body's index in place of the mask flag.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[repr(C)]
+pub(crate) struct BodySurface {
+    pub cell: u32,
+    pub normal: [f32; 3],
+    pub restitution: f32,
+    pub body: u32,
+}
+
+/// The body surface entry of `cell`, with its index in the table.
+#[inline]
+pub(crate) fn body_surface_at(table: &[BodySurface], cell: u32) -> Option<(usize, &BodySurface)> {
+    table.binary_search_by_key(&cell, |s| s.cell).ok().map(|i| (i, &table[i]))
+}
+
+/// A slot of the body table. `kind` 0 is a free slot; otherwise the shape
+/// is `kind`, `a`, `b` and `radius` ([`Body::shape`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[repr(C)]
+pub(crate) struct Body {
+    pub kind: u32,
+    pub restitution: f32,
+    pub a: [f32; 3],
+    pub b: [f32; 3],
+    pub radius: f32,
+    pub velocity: [f32; 3],
+    /// The velocity in fine units (M1c), converted where the step and the
+    /// push-outs read it: at every redraw and at the start of every step.
+    pub fine: [i32; 3],
+    pub spare: u32,
+    pub current: Tally,
+    pub last: Tally,
+}
+
+/// The head of the body table's plane: the world's count of particles the
+/// bodies crushed, the redraws since the last step (M13's `r`) and the
+/// used entries of the body surface table.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[repr(C)]
+pub(crate) struct BodiesHead {
+    pub crushed: u64,
+    pub redraws: u32,
+    pub surfaces: u32,
+}
+
+impl Body {
+    /// A free slot.
+    pub(crate) const ZERO: Body = Body {
+        kind: 0,
+        restitution: 0.0,
+        a: [0.0; 3],
+        b: [0.0; 3],
+        radius: 0.0,
+        velocity: [0.0; 3],
+        fine: [0; 3],
+        spare: 0,
+        current: Tally::ZERO,
+        last: Tally::ZERO,
+    };
+
+    /// A body of `shape`, velocity `u` and restitution `e`, checked for a
+    /// world of `dim` dimensions.
+    pub(crate) fn new(shape: Shape, u: [f32; 3], e: f32, dim: usize) -> Result<Body, Error> {
+        shape.check(dim)?;
+        restitution(e)?;
+        let mut body = Body { restitution: e, ..Body::default() };
+        body.set(shape.in_dim(dim), u, dim)?;
+        Ok(body)
+    }
+
+    /// Gives the body a new shape and velocity (checked), keeping its
+    /// restitution and tallies.
+    pub(crate) fn set(&mut self, shape: Shape, u: [f32; 3], dim: usize) -> Result<(), Error> {
+        shape.check(dim)?;
+        finite(&u)?;
+        let mut u = u;
+        if dim == 2 {
+            u[2] = 0.0;
+        }
+        if u[0] * u[0] + u[1] * u[1] + u[2] * u[2] > 1.0 {
+            return Err(Error::SpeedRange);
+        }
+        let (kind, a, b, radius) = match shape.in_dim(dim) {
+            Shape::HalfSpace { point, normal } => (1, point, normal, 0.0),
+            Shape::Box { min, max } => (2, min, max, 0.0),
+            Shape::Disc { centre, radius } => (3, [centre[0], centre[1], 0.0], [0.0; 3], radius),
+            Shape::Sphere { centre, radius } => (4, centre, [0.0; 3], radius),
+            Shape::Capsule { a, b, radius } => (5, a, b, radius),
+        };
+        (self.kind, self.a, self.b, self.radius, self.velocity) = (kind, a, b, radius, u);
+        Ok(())
+    }
+
+    /// The body's shape, or `None` for a free slot or a slot no version of
+    /// the library writes.
+    pub(crate) fn shape(&self) -> Option<Shape> {
+        let (a, b, radius) = (self.a, self.b, self.radius);
+        Some(match self.kind {
+            1 => Shape::HalfSpace { point: a, normal: b },
+            2 => Shape::Box { min: a, max: b },
+            3 => Shape::Disc { centre: [a[0], a[1]], radius },
+            4 => Shape::Sphere { centre: a, radius },
+            5 => Shape::Capsule { a, b, radius },
+            _ => return None,
+        })
+    }
+}
+
+/// `v - u`, component by component: both within the saturation bound, so
+/// the difference fits an `i32`.
+#[inline]
+pub(crate) fn relative(v: [i32; 3], u: [i32; 3]) -> [i32; 3] {
+    [0, 1, 2].map(|k| v[k] - u[k])
+}
+
+/// M13's push-out velocity: what the particle had into the surface,
+/// relative to it, removed, `v' = v - min(0, (v - u).N) N` (`N` a unit
+/// normal in Q30); what it had along the surface is kept.
+pub(crate) fn pushed_velocity(v: [i32; 3], u: [i32; 3], n: [i32; 3]) -> [i32; 3] {
+    let into = dot_q30(relative(v, u), n);
+    if into >= 0 {
+        return v;
+    }
+    // `into` is below 2^60 in magnitude; rounded down once to fine units.
+    let s = into >> 30;
+    [0, 1, 2].map(|k| sat(i64::from(v[k]) - ((s * i64::from(n[k])) >> 30)))
+}
+
+/// The offsets M13's push-out tries, for a world of `dim` dimensions, in
+/// rings: `ring` 1 holds the offsets with every component in -1..=1, ring 2
+/// those reaching 2; each is passed to `f` with its ring, in x-fastest
+/// order within the ring (the caller orders them by `d.N`).
+pub(crate) fn for_ring(dim: usize, ring: i32, f: &mut dyn FnMut([i32; 3])) {
+    let zr = if dim == 3 { -ring..=ring } else { 0..=0 };
+    for dz in zr {
+        for dy in -ring..=ring {
+            for dx in -ring..=ring {
+                let d = [dx, dy, dz];
+                if d.iter().map(|c| c.abs()).max() == Some(ring) {
+                    f(d);
+                }
+            }
+        }
+    }
+}
