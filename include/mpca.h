@@ -316,6 +316,14 @@ enum mpca_status
    */
   MPCA_STATUS_IDS_EXHAUSTED = 141,
   /**
+   * Every slot of the body table holds a body (M13).
+   */
+  MPCA_STATUS_BODY_TABLE_FULL = 142,
+  /**
+   * The id names no body: never given, or its body was removed (M13).
+   */
+  MPCA_STATUS_NO_BODY = 143,
+  /**
    * An error this version of the C ABI does not know by name.
    */
   MPCA_STATUS_UNKNOWN = 199,
@@ -557,6 +565,11 @@ enum mpca_shape_kind
    * A sphere of centre `a` and radius `radius`, 3D worlds only.
    */
   MPCA_SHAPE_KIND_SPHERE = 3,
+  /**
+   * The points within `radius` of the segment from `a` to `b` (in 2D
+   * their x and y).
+   */
+  MPCA_SHAPE_KIND_CAPSULE = 4,
 };
 #ifndef __cplusplus
 #if __STDC_VERSION__ >= 202311L
@@ -624,6 +637,66 @@ typedef uint32_t mpca_shape_kind;
  * firmware world is used by one call at a time.
  */
 typedef struct mpca_world mpca_world;
+
+/**
+ * An obstacle shape (M7) as one value: to ask what it takes
+ * (mpca_desc_surface_entries, mpca_world_surface_entries) and to add it
+ * (mpca_world_add_shape). Set `struct_size` to `sizeof(mpca_shape)`.
+ */
+typedef struct mpca_shape {
+  /**
+   * `sizeof(mpca_shape)`.
+   */
+  uint32_t struct_size;
+  /**
+   * An `mpca_shape_kind`.
+   */
+  uint32_t kind;
+  /**
+   * A point on the plane (half-space), the lower corner (box), the
+   * centre (disc, sphere), one end (capsule).
+   */
+  float a[3];
+  /**
+   * The outward normal (half-space), the upper corner (box), the other
+   * end (capsule); not read for a disc or a sphere.
+   */
+  float b[3];
+  /**
+   * The radius (disc, sphere, capsule); not read for the others.
+   */
+  float radius;
+} mpca_shape;
+
+/**
+ * What a body gave the particles in the last step (M13). Set
+ * `struct_size` to `sizeof(mpca_body_stats)`.
+ */
+typedef struct mpca_body_stats {
+  /**
+   * `sizeof(mpca_body_stats)`, set by the caller.
+   */
+  uint32_t struct_size;
+  /**
+   * Particles reflected off the body's cells in the last step.
+   */
+  uint32_t reflected;
+  /**
+   * Particles pushed out of cells the body took, by the moves before
+   * the last step.
+   */
+  uint32_t pushed;
+  /**
+   * Particles those moves removed for want of a free cell near the body.
+   */
+  uint32_t crushed;
+  /**
+   * The momentum the body gave the particles, `sum m (v' - v)`, in the
+   * world's mass times cells per step: push a rigid body back by minus
+   * this.
+   */
+  double momentum[3];
+} mpca_body_stats;
 
 /**
  * A scene description. Fill it with mpca_desc_defaults, then change the
@@ -766,6 +839,17 @@ typedef struct mpca_desc {
    * (M6b); 0, none, by default.
    */
   uint32_t identity;
+  /**
+   * How many bodies, obstacles the caller moves (M13, with `obstacles`),
+   * fit; 0 by default.
+   */
+  uint32_t body_capacity;
+  /**
+   * How many body surface cells fit (M13): every body cell with a free
+   * neighbour takes one; mpca_desc_surface_entries of a body's shape is
+   * an upper bound for it.
+   */
+  uint32_t body_surface_capacity;
 } mpca_desc;
 
 /**
@@ -808,36 +892,6 @@ typedef struct mpca_emitter {
    */
   uint32_t lifetime;
 } mpca_emitter;
-
-/**
- * An obstacle shape (M7) as one value: to ask what it takes
- * (mpca_desc_surface_entries, mpca_world_surface_entries) and to add it
- * (mpca_world_add_shape). Set `struct_size` to `sizeof(mpca_shape)`.
- */
-typedef struct mpca_shape {
-  /**
-   * `sizeof(mpca_shape)`.
-   */
-  uint32_t struct_size;
-  /**
-   * An `mpca_shape_kind`.
-   */
-  uint32_t kind;
-  /**
-   * A point on the plane (half-space), the lower corner (box), the
-   * centre (disc, sphere).
-   */
-  float a[3];
-  /**
-   * The outward normal (half-space), the upper corner (box); not read
-   * for a disc or a sphere.
-   */
-  float b[3];
-  /**
-   * The radius (disc, sphere); not read for the others.
-   */
-  float radius;
-} mpca_shape;
 
 /**
  * The host's parallel-for, called once per step by
@@ -975,6 +1029,10 @@ typedef struct mpca_stats {
    */
   uint64_t emit_shortfall;
   /**
+   * Particles bodies removed for want of a free cell near them (M13).
+   */
+  uint64_t crushed;
+  /**
    * Particle-particle collisions.
    */
   uint64_t collisions;
@@ -1057,6 +1115,46 @@ const char *mpca_version(void);
  */
 mpca_status mpca_debug_panic(void);
 #endif
+
+/**
+ * Adds a body of `shape` moving at `velocity` (3 values, cells per step,
+ * speed at most 1) with restitution `e`; its id goes to `out_id`. The body
+ * covers the cells of its shape that no static obstacle or earlier body
+ * covers, and the particles in them are pushed out. Refused:
+ * MPCA_STATUS_NOT_ENABLED without `mpca_desc.body_capacity`,
+ * MPCA_STATUS_BODY_TABLE_FULL, MPCA_STATUS_SURFACE_TABLE_FULL where
+ * `body_surface_capacity` would not hold the body's surface cells, and the
+ * shape's, speed's and restitution's own statuses.
+ */
+mpca_status mpca_world_add_body(struct mpca_world *world,
+                                const struct mpca_shape *shape,
+                                const float *velocity,
+                                float e,
+                                uint32_t *out_id);
+
+/**
+ * Gives body `id` a new shape (at its new place) and velocity (3 values);
+ * refused as mpca_world_add_body, and with MPCA_STATUS_NO_BODY where `id`
+ * names none.
+ */
+mpca_status mpca_world_move_body(struct mpca_world *world,
+                                 uint32_t id,
+                                 const struct mpca_shape *shape,
+                                 const float *velocity);
+
+/**
+ * Removes body `id`; its cells are free again. MPCA_STATUS_NO_BODY where
+ * `id` names none.
+ */
+mpca_status mpca_world_remove_body(struct mpca_world *world, uint32_t id);
+
+/**
+ * Fills `out` (whose `struct_size` the caller set) with what body `id`
+ * gave the particles in the last step.
+ */
+mpca_status mpca_world_body_stats(const struct mpca_world *world,
+                                  uint32_t id,
+                                  struct mpca_body_stats *out);
 
 /**
  * Fills `out` with the defaults for a `dim`-dimensional world of
@@ -1200,7 +1298,7 @@ mpca_status mpca_world_surface_entries(const struct mpca_world *world,
  * Adds `shape`'s cells as obstacles of restitution `e`, with normals from
  * its exact geometry: the same as the call for its kind
  * (mpca_world_add_half_space, mpca_world_add_box, mpca_world_add_disc,
- * mpca_world_add_sphere).
+ * mpca_world_add_sphere; a capsule has only this one).
  */
 mpca_status mpca_world_add_shape(struct mpca_world *world, const struct mpca_shape *shape, float e);
 

@@ -552,6 +552,34 @@ public:
     /** Gives the particles emitter `index` places the tag `tag`. */
     void set_emitter_tag(std::uint32_t index, std::uint32_t tag) { check(mpca_world_set_emitter_tag(w_, index, tag)); }
 
+    /** Adds a body, an obstacle the caller moves (mpca_world_add_body), and
+     * returns its id; sets the shape's struct_size. */
+    std::uint32_t add_body(mpca_shape shape, const vec3 &velocity, float e) {
+        shape.struct_size = sizeof shape;
+        std::uint32_t id = 0;
+        check(mpca_world_add_body(w_, &shape, velocity.data(), e, &id));
+        return id;
+    }
+
+    /** Gives body `id` a new shape and velocity (mpca_world_move_body);
+     * sets the shape's struct_size. */
+    void move_body(std::uint32_t id, mpca_shape shape, const vec3 &velocity) {
+        shape.struct_size = sizeof shape;
+        check(mpca_world_move_body(w_, id, &shape, velocity.data()));
+    }
+
+    /** Removes body `id` (mpca_world_remove_body). */
+    void remove_body(std::uint32_t id) { check(mpca_world_remove_body(w_, id)); }
+
+    /** What body `id` gave the particles in the last step
+     * (mpca_world_body_stats). */
+    mpca_body_stats body_stats(std::uint32_t id) const {
+        mpca_body_stats s = mpca_body_stats();
+        s.struct_size = sizeof s;
+        check(mpca_world_body_stats(w_, id, &s));
+        return s;
+    }
+
 private:
     typedef mpca_status (*export_fn)(const mpca_world *, float *, std::size_t, std::size_t *);
 

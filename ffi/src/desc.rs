@@ -164,6 +164,13 @@ pub struct mpca_desc {
     /// `mpca_identity` bits: ids, ages and tags carried with the particles
     /// (M6b); 0, none, by default.
     pub identity: u32,
+    /// How many bodies, obstacles the caller moves (M13, with `obstacles`),
+    /// fit; 0 by default.
+    pub body_capacity: u32,
+    /// How many body surface cells fit (M13): every body cell with a free
+    /// neighbour takes one; mpca_desc_surface_entries of a body's shape is
+    /// an upper bound for it.
+    pub body_surface_capacity: u32,
 }
 
 /// Description::new_2d's defaults as C sees them (the sizes aside), built
@@ -243,6 +250,8 @@ impl mpca_desc {
             drag_vortex: d.drag.vortex as u32,
             drag_wind_field: d.drag.field as u32,
             identity: d.identity.bits(),
+            body_capacity: d.body_capacity,
+            body_surface_capacity: d.body_surface_capacity,
         }
     }
 
@@ -293,6 +302,7 @@ impl mpca_desc {
         d.mass = self.mass;
         d.mass_classes = self.mass_classes;
         d.surface_capacity = self.surface_capacity;
+        (d.body_capacity, d.body_surface_capacity) = (self.body_capacity, self.body_surface_capacity);
         d.forces = Forces {
             uniform: self.forces & mpca_force::Uniform as u32 != 0,
             field: self.forces & mpca_force::Field as u32 != 0,

@@ -50,6 +50,7 @@ extern crate alloc;
 #[cfg(all(feature = "hosted", not(any(test, feature = "catch-panics")), panic = "unwind"))]
 compile_error!("libmpca without catch-panics is built with panic = \"abort\" (the workspace's dev and release profiles set it)");
 
+mod bodies;
 mod call;
 mod desc;
 mod emitters;
@@ -68,6 +69,7 @@ mod sys;
 mod world;
 
 pub(crate) use call::{fits, guard, Call};
+pub use bodies::*;
 pub use desc::*;
 pub use emitters::*;
 pub use forces::*;
@@ -99,8 +101,9 @@ pub extern "C" fn mpca_version() -> *const core::ffi::c_char {
 // The layout C sees, fixed: the C tests assert the same with _Static_assert.
 const _: () = {
     use core::mem::{align_of, size_of};
-    assert!(size_of::<mpca_desc>() == 176 && align_of::<mpca_desc>() == 8);
-    assert!(size_of::<mpca_stats>() == 144 && align_of::<mpca_stats>() == 8);
+    assert!(size_of::<mpca_desc>() == 184 && align_of::<mpca_desc>() == 8);
+    assert!(size_of::<mpca_stats>() == 152 && align_of::<mpca_stats>() == 8);
+    assert!(size_of::<mpca_body_stats>() == 40 && align_of::<mpca_body_stats>() == 8);
     assert!(size_of::<mpca_region_stats>() == 48 && align_of::<mpca_region_stats>() == 8);
     assert!(size_of::<mpca_particle>() == 44 && align_of::<mpca_particle>() == 4);
     assert!(size_of::<mpca_cell>() == 48 && align_of::<mpca_cell>() == 4);

@@ -21,6 +21,9 @@ pub enum mpca_shape_kind {
     Disc = 2,
     /// A sphere of centre `a` and radius `radius`, 3D worlds only.
     Sphere = 3,
+    /// The points within `radius` of the segment from `a` to `b` (in 2D
+    /// their x and y).
+    Capsule = 4,
 }
 
 /// An obstacle shape (M7) as one value: to ask what it takes
@@ -34,19 +37,19 @@ pub struct mpca_shape {
     /// An `mpca_shape_kind`.
     pub kind: u32,
     /// A point on the plane (half-space), the lower corner (box), the
-    /// centre (disc, sphere).
+    /// centre (disc, sphere), one end (capsule).
     pub a: [f32; 3],
-    /// The outward normal (half-space), the upper corner (box); not read
-    /// for a disc or a sphere.
+    /// The outward normal (half-space), the upper corner (box), the other
+    /// end (capsule); not read for a disc or a sphere.
     pub b: [f32; 3],
-    /// The radius (disc, sphere); not read for the others.
+    /// The radius (disc, sphere, capsule); not read for the others.
     pub radius: f32,
 }
 
 impl mpca_shape {
     /// The core's shape; a wrong `struct_size` or an unknown kind is
     /// refused here, the geometry by the core.
-    fn to_core(self) -> Result<Shape, mpca_status> {
+    pub(crate) fn to_core(self) -> Result<Shape, mpca_status> {
         check_size::<mpca_shape>(self.struct_size)?;
         let (a, b, radius) = (self.a, self.b, self.radius);
         Ok(match self.kind {
@@ -54,6 +57,7 @@ impl mpca_shape {
             1 => Shape::Box { min: a, max: b },
             2 => Shape::Disc { centre: [a[0], a[1]], radius },
             3 => Shape::Sphere { centre: a, radius },
+            4 => Shape::Capsule { a, b, radius },
             _ => return Err(mpca_status::BadEnum),
         })
     }
@@ -94,7 +98,7 @@ pub unsafe extern "C" fn mpca_world_surface_entries(world: *const mpca_world, sh
 /// Adds `shape`'s cells as obstacles of restitution `e`, with normals from
 /// its exact geometry: the same as the call for its kind
 /// (mpca_world_add_half_space, mpca_world_add_box, mpca_world_add_disc,
-/// mpca_world_add_sphere).
+/// mpca_world_add_sphere; a capsule has only this one).
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mpca_world_add_shape(world: *mut mpca_world, shape: *const mpca_shape, e: f32) -> mpca_status {
     guard(|c| {

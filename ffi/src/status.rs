@@ -278,3 +278,10 @@ pub(crate) const fn status_from_u32(n: u32) -> Option<mpca_status> {
     }
     None
 }
+
+/// The status of a call for a part this build left out, once its arguments
+/// (`_checked`) were read and checked: no world of the build has the part.
+#[cfg(not(feature = "obstacles"))]
+pub(crate) fn disabled<T>(_checked: T) -> mpca_status {
+    mpca_status::NotEnabled
+}

@@ -187,6 +187,8 @@ pub struct mpca_stats {
     pub expired: u64,
     /// Particles emitters could not place for lack of room.
     pub emit_shortfall: u64,
+    /// Particles bodies removed for want of a free cell near them (M13).
+    pub crushed: u64,
     /// Particle-particle collisions.
     pub collisions: u64,
     /// Velocities scaled back to |v| = 1.
@@ -225,6 +227,7 @@ pub unsafe extern "C" fn mpca_world_stats(world: *const mpca_world, out: *mut mp
             exited: s.exited,
             expired: s.expired,
             emit_shortfall: s.emit_shortfall,
+            crushed: s.crushed,
             collisions: s.collisions,
             clamps: s.clamps,
             displaced: s.displaced,

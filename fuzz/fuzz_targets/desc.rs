@@ -31,6 +31,8 @@ fn core_desc(c: &mpca_desc) -> Description {
     d.mass_classes = c.mass_classes % 300;
     d.obstacles = c.obstacles & 1 == 1;
     d.surface_capacity = c.surface_capacity % 100;
+    d.body_capacity = c.body_capacity % 5;
+    d.body_surface_capacity = c.body_surface_capacity % 100;
     d.forces.uniform = c.forces & 1 != 0;
     d.forces.field = c.forces & 2 != 0;
     d.forces.potential = c.forces & 4 != 0;
@@ -69,6 +71,8 @@ fn to_c(d: &Description) -> mpca_desc {
     c.mass_classes = d.mass_classes;
     c.obstacles = u32::from(d.obstacles);
     c.surface_capacity = d.surface_capacity;
+    c.body_capacity = d.body_capacity;
+    c.body_surface_capacity = d.body_surface_capacity;
     let f = d.forces;
     c.forces = u32::from(f.uniform) | u32::from(f.field) << 1 | u32::from(f.potential) << 2 | u32::from(f.vortex) << 3;
     c.gravity = d.gravity;

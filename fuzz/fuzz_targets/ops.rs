@@ -17,11 +17,13 @@
 //!   the world, and a density at full resolution give the statistics'
 //!   figures bit for bit;
 //! - an image saved and loaded into a world built from its description
-//!   hashes equal and steps on equal.
+//!   hashes equal and steps on equal;
+//! - bodies (M13) added, moved and removed at random push particles out
+//!   or crush them, and every particle stays accounted for.
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use mpca_ffi::{mpca_cell_kind, mpca_emitter, mpca_status};
+use mpca_ffi::{mpca_cell_kind, mpca_emitter, mpca_shape, mpca_status};
 use mpca_fuzz::{desc_from_image, scene, validate, Input, World};
 
 /// What the model knows of the world between calls.
@@ -43,7 +45,7 @@ impl Model {
     fn check(&self, w: &World) {
         let s = w.stats();
         assert_eq!(s.step, self.steps, "step count");
-        assert_eq!(s.particles + self.removed + s.exited + s.expired, self.added + s.emitted, "particles not accounted for: {s:?}");
+        assert_eq!(s.particles + self.removed + s.exited + s.expired + s.crushed, self.added + s.emitted, "particles not accounted for: {s:?}");
         assert_eq!(w.count() as u64, s.particles, "count and statistics disagree");
         assert!(self.open || s.exited == 0, "a particle exited a world without open faces");
         assert!(self.lifetimes || s.expired == 0, "a particle expired in a world without lifetimes");
@@ -156,7 +158,7 @@ fuzz_target!(|data: &[u8]| {
             break;
         }
         let before = (w.save(), w.hash());
-        let op = input.pick(22);
+        let op = input.pick(24);
         let result: Result<(), mpca_status> = match op {
             0 | 1 => {
                 let (pos, v) = (input.position(n), input.vector());
@@ -307,6 +309,24 @@ fuzz_target!(|data: &[u8]| {
                 w.set_wind_field(&u)
             }
             20 => w.set_cell_wind(input.position(n), input.vector().map(|u| u * 0.8)),
+            21 | 22 => {
+                // A body added or moved anywhere, now and then too fast or
+                // degenerate (refused whole), or removed.
+                let scale = n.map(|c| c as f32);
+                let shape = mpca_shape {
+                    struct_size: size_of::<mpca_shape>() as u32,
+                    kind: input.pick(6) as u32,
+                    a: core::array::from_fn(|k| input.value() * scale[k]),
+                    b: core::array::from_fn(|k| input.value() * scale[k]),
+                    radius: input.value() * 4.0,
+                };
+                let (u, e, id) = (input.vector().map(|c| c * 0.8), input.value(), input.pick(4) as u32);
+                match (op, input.pick(3)) {
+                    (21, _) => w.add_body(&shape, u, e).map(drop),
+                    (_, 0) => w.remove_body(id),
+                    _ => w.move_body(id, &shape, u),
+                }
+            }
             _ => Err(w.refused_calls(input.u8() as usize)),
         };
         if result.is_err() {

@@ -138,6 +138,9 @@ pub fn scene(input: &mut Input<'_>) -> mpca_desc {
     d.drag_wind = input.vector().map(|w| w / 2.0);
     d.drag_vortex = u32::from(parts & 256 != 0);
     d.drag_wind_field = u32::from(parts & 512 != 0);
+    // Bodies (M13), with obstacles: up to three, and room for a few cells.
+    d.body_capacity = input.pick(4) as u32;
+    d.body_surface_capacity = input.pick(129) as u32;
     d
 }
 
@@ -186,6 +189,8 @@ fn desc_words(d: &mut mpca_desc, each: &mut dyn FnMut(&mut u32)) {
     each(&mut d.drag_vortex);
     each(&mut d.drag_wind_field);
     each(&mut d.identity);
+    each(&mut d.body_capacity);
+    each(&mut d.body_surface_capacity);
 }
 
 /// An `mpca_desc` from the input, every field any value.
@@ -363,6 +368,22 @@ impl World {
     pub fn set_emitter_rate(&mut self, index: u32, rate: f32) -> Result<(), mpca_status> {
         // SAFETY: a live handle.
         status(unsafe { mpca_world_set_emitter_rate(self.handle, index, rate) })
+    }
+
+    pub fn add_body(&mut self, shape: &mpca_shape, u: [f32; 3], e: f32) -> Result<u32, mpca_status> {
+        let mut id = u32::MAX;
+        // SAFETY: a live handle, a shape, an array of 3 and an out value.
+        status(unsafe { mpca_world_add_body(self.handle, shape, u.as_ptr(), e, &mut id) }).map(|()| id)
+    }
+
+    pub fn move_body(&mut self, id: u32, shape: &mpca_shape, u: [f32; 3]) -> Result<(), mpca_status> {
+        // SAFETY: a live handle, a shape and an array of 3.
+        status(unsafe { mpca_world_move_body(self.handle, id, shape, u.as_ptr()) })
+    }
+
+    pub fn remove_body(&mut self, id: u32) -> Result<(), mpca_status> {
+        // SAFETY: a live handle.
+        status(unsafe { mpca_world_remove_body(self.handle, id) })
     }
 
     pub fn add_obstacle(&mut self, pos: [u32; 3], normal: [f32; 3], e: f32) -> Result<(), mpca_status> {

@@ -318,6 +318,31 @@ static void same_as_c() {
     THROWS(MPCA_STATUS_BAD_ENUM, s.add_shape(ball, 1.0f));
     CHECK(s.cell({8, 8, 8}).kind == MPCA_CELL_KIND_OBSTACLE && std::strcmp(mpca::version(), mpca_version()) == 0);
 
+    /* Bodies (M13): a capsule added over a particle pushes it out; moved,
+     * its tally is read; an id that names no body throws. */
+    mpca_desc db = mpca::desc_2d(16, 16);
+    db.obstacles = 1;
+    db.body_capacity = 1;
+    db.body_surface_capacity = 64;
+    mpca::world b(db);
+    b.add_particle({5, 5, 0}, {0.0f, 0.0f, 0.0f});
+    mpca_shape paddle = mpca_shape();
+    paddle.kind = MPCA_SHAPE_KIND_CAPSULE;
+    paddle.a[0] = 5.5f;
+    paddle.a[1] = 3.0f;
+    paddle.b[0] = 5.5f;
+    paddle.b[1] = 8.0f;
+    paddle.radius = 0.6f;
+    const std::uint32_t id = b.add_body(paddle, {0.5f, 0.0f, 0.0f}, 1.0f);
+    CHECK(b.cell({5, 5, 0}).kind == MPCA_CELL_KIND_OBSTACLE && b.particle_count() == 1);
+    b.step(1);
+    CHECK(b.body_stats(id).pushed == 1);
+    paddle.a[0] = paddle.b[0] = 6.5f;
+    b.move_body(id, paddle, {0.5f, 0.0f, 0.0f});
+    THROWS(MPCA_STATUS_NO_BODY, b.move_body(id + 1, paddle, {0.0f, 0.0f, 0.0f}));
+    b.remove_body(id);
+    THROWS(MPCA_STATUS_NO_BODY, b.body_stats(id));
+
     /* The wind plane (M5.1b): a particle at rest in a wind of (0.5, 0)
      * with drag k = 1 moves off along +x; a wind too fast is refused. */
     mpca_desc dw = mpca::desc_2d(16, 16);
@@ -610,6 +635,10 @@ static void every_function() {
     WRAPS(mpca_world_add_emitter, &W::add_emitter);
     WRAPS(mpca_world_set_emitter_rate, &W::set_emitter_rate);
     WRAPS(mpca_world_emitter_stats, &W::emitter_stats);
+    WRAPS(mpca_world_add_body, &W::add_body);
+    WRAPS(mpca_world_move_body, &W::move_body);
+    WRAPS(mpca_world_remove_body, &W::remove_body);
+    WRAPS(mpca_world_body_stats, &W::body_stats);
     std::printf("cpp: every function\n");
 }
 

@@ -19,8 +19,9 @@
 #include "check.h"
 
 /* The layout ffi/src/lib.rs asserts on the Rust side. */
-STATIC_ASSERT(sizeof(mpca_desc) == 176 && ALIGNOF(mpca_desc) == 8, "mpca_desc layout");
-STATIC_ASSERT(sizeof(mpca_stats) == 144 && ALIGNOF(mpca_stats) == 8, "mpca_stats layout");
+STATIC_ASSERT(sizeof(mpca_desc) == 184 && ALIGNOF(mpca_desc) == 8, "mpca_desc layout");
+STATIC_ASSERT(sizeof(mpca_stats) == 152 && ALIGNOF(mpca_stats) == 8, "mpca_stats layout");
+STATIC_ASSERT(sizeof(mpca_body_stats) == 40 && ALIGNOF(mpca_body_stats) == 8, "mpca_body_stats layout");
 STATIC_ASSERT(sizeof(mpca_particle) == 44 && ALIGNOF(mpca_particle) == 4, "mpca_particle layout");
 STATIC_ASSERT(sizeof(mpca_particle_columns) == 8 + 5 * sizeof(void *) && ALIGNOF(mpca_particle_columns) == ALIGNOF(void *), "mpca_particle_columns layout");
 STATIC_ASSERT(sizeof(mpca_cell) == 48 && ALIGNOF(mpca_cell) == 4, "mpca_cell layout");
@@ -79,6 +80,16 @@ static uint64_t world_fingerprint(const mpca_world *w, uint64_t h) {
     h = fnv(h, &s, sizeof s);
     h = fnv(h, &hash, sizeof hash);
     h = fnv(h, &count, sizeof count);
+    /* The body table (M13), where the world has one: each slot's tally or
+     * its status. */
+    for (uint32_t id = 0; id < 4; id++) {
+        mpca_body_stats b;
+        memset(&b, 0, sizeof b);
+        b.struct_size = sizeof b;
+        mpca_status st = mpca_world_body_stats(w, id, &b);
+        h = fnv(h, &st, sizeof st);
+        h = fnv(h, &b, sizeof b);
+    }
     uint32_t nz = d.dim == 3 ? d.size[2] : 1;
     for (uint32_t z = 0; z < nz; z++) {
         for (uint32_t y = 0; y < d.size[1]; y++) {
@@ -209,6 +220,7 @@ static mpca_world *full3; /* from mpca_world_create */
 static mpca_world *bare2; /* defaults: nothing enabled, 8 x 8 */
 static mpca_world *small2; /* obstacles with room for one surface cell, 8 x 8 */
 static mpca_world *emit2;  /* as full2, from mpca_world_create, with room for 16 emitters */
+static mpca_world *body2;  /* walls on x, room for two bodies (body_cases) */
 static unsigned char *full2_memory, *small2_memory;
 static size_t full2_bytes;
 
@@ -1021,7 +1033,7 @@ static void shape_cases(void) {
 
     mpca_shape bad = disc;
     uint32_t out = SENTINEL_U32;
-    bad.kind = 4;
+    bad.kind = 5;
     REFUSED(MPCA_STATUS_BAD_ENUM, mpca_desc_surface_entries(&d, &bad, &out));
     REFUSED(MPCA_STATUS_BAD_ENUM, mpca_world_surface_entries(full2, &bad, &out));
     REFUSED(MPCA_STATUS_BAD_ENUM, mpca_world_add_shape(full2, &bad, 1.0f));
@@ -1060,6 +1072,95 @@ static void shape_cases(void) {
     floor.b[1] = 1.0f;
     CHECK_OK(mpca_world_surface_entries(full2, &floor, &now));
     CHECK(now == 0); /* full2 has this floor already */
+}
+
+/* --- Bodies (M13) ------------------------------------------------------ */
+
+static void body_cases(void) {
+    set_context("bodies: a world with room for two");
+    mpca_desc d;
+    CHECK_OK(mpca_desc_defaults(&d, 2, N2, N2, 0));
+    d.boundary[0][0] = d.boundary[0][1] = MPCA_BOUNDARY_WALL;
+    d.obstacles = 1;
+    d.surface_capacity = 16;
+    d.body_capacity = 2;
+    d.body_surface_capacity = 24;
+    CHECK_OK(mpca_world_create(&d, &body2));
+    mpca_world *w = body2;
+    watch(w);
+    uint32_t pos[3] = {6, 6, 0};
+    float v[3] = {0.25f, 0, 0}, u[3] = {0.5f, 0, 0}, still[3] = {0, 0, 0};
+    CHECK_OK(mpca_world_add_particle(w, pos, v));
+    mpca_shape disc = shape_of(MPCA_SHAPE_KIND_DISC);
+    disc.a[0] = 6.0f;
+    disc.a[1] = 6.5f;
+    disc.radius = 0.9f;
+    uint32_t id = SENTINEL_U32;
+    CHECK_OK(mpca_world_add_body(w, &disc, u, 0.5f, &id));
+    CHECK(id == 0);
+    /* The disc took the particle's cell: pushed, none lost. */
+    mpca_cell c;
+    CHECK_OK(mpca_world_cell(w, pos, &c));
+    CHECK(c.kind == MPCA_CELL_KIND_OBSTACLE);
+    size_t count = 0;
+    CHECK_OK(mpca_world_particle_count(w, &count));
+    CHECK(count == 1);
+    CHECK_OK(mpca_world_step(w, 1));
+    mpca_body_stats b;
+    memset(&b, 0, sizeof b);
+    b.struct_size = sizeof b;
+    CHECK_OK(mpca_world_body_stats(w, id, &b));
+    CHECK(b.pushed == 1 && b.crushed == 0);
+    mpca_shape capsule = shape_of(MPCA_SHAPE_KIND_CAPSULE);
+    capsule.a[0] = 10.0f;
+    capsule.a[1] = 10.0f;
+    capsule.b[0] = 12.0f;
+    capsule.b[1] = 11.0f;
+    capsule.radius = 0.8f;
+    CHECK_OK(mpca_world_move_body(w, id, &capsule, still));
+
+    set_context("bodies: refusals");
+    uint32_t out = SENTINEL_U32;
+    REFUSED(MPCA_STATUS_NULL_POINTER, mpca_world_add_body(NULL, &disc, u, 1.0f, &out));
+    REFUSED(MPCA_STATUS_NULL_POINTER, mpca_world_add_body(w, NULL, u, 1.0f, &out));
+    REFUSED(MPCA_STATUS_NULL_POINTER, mpca_world_add_body(w, &disc, NULL, 1.0f, &out));
+    REFUSED(MPCA_STATUS_NULL_POINTER, mpca_world_add_body(w, &disc, u, 1.0f, NULL));
+    REFUSED(MPCA_STATUS_NULL_POINTER, mpca_world_move_body(w, id, NULL, u));
+    REFUSED(MPCA_STATUS_NULL_POINTER, mpca_world_move_body(w, id, &disc, NULL));
+    REFUSED(MPCA_STATUS_NULL_POINTER, mpca_world_remove_body(NULL, id));
+    REFUSED(MPCA_STATUS_NULL_POINTER, mpca_world_body_stats(w, id, NULL));
+    mpca_shape bad = disc;
+    bad.kind = 5;
+    REFUSED(MPCA_STATUS_BAD_ENUM, mpca_world_add_body(w, &bad, u, 1.0f, &out));
+    bad = disc;
+    bad.struct_size = sizeof bad + 4;
+    REFUSED(MPCA_STATUS_BAD_STRUCT_SIZE, mpca_world_move_body(w, id, &bad, u));
+    bad = disc;
+    bad.radius = 0.0f;
+    REFUSED(MPCA_STATUS_BAD_SHAPE, mpca_world_add_body(w, &bad, u, 1.0f, &out));
+    bad.radius = NAN;
+    REFUSED(MPCA_STATUS_NOT_FINITE, mpca_world_move_body(w, id, &bad, u));
+    float fast[3] = {0.8f, 0.8f, 0};
+    REFUSED(MPCA_STATUS_SPEED_RANGE, mpca_world_add_body(w, &disc, fast, 1.0f, &out));
+    REFUSED(MPCA_STATUS_SPEED_RANGE, mpca_world_move_body(w, id, &disc, fast));
+    REFUSED(MPCA_STATUS_RESTITUTION_RANGE, mpca_world_add_body(w, &disc, u, 1.5f, &out));
+    bad = disc;
+    bad.radius = 6.0f;
+    REFUSED(MPCA_STATUS_SURFACE_TABLE_FULL, mpca_world_add_body(w, &bad, u, 1.0f, &out));
+    REFUSED(MPCA_STATUS_NO_BODY, mpca_world_move_body(w, 1, &disc, u));
+    REFUSED(MPCA_STATUS_NO_BODY, mpca_world_remove_body(w, 7));
+    REFUSED(MPCA_STATUS_NO_BODY, mpca_world_body_stats(w, 1, &b));
+    b.struct_size = sizeof b - 8;
+    REFUSED(MPCA_STATUS_BAD_STRUCT_SIZE, mpca_world_body_stats(w, id, &b));
+    b.struct_size = sizeof b;
+    REFUSED(MPCA_STATUS_NOT_ENABLED, mpca_world_add_body(full2, &disc, u, 1.0f, &out));
+    REFUSED(MPCA_STATUS_NOT_ENABLED, mpca_world_body_stats(full2, 0, &b));
+    CHECK(out == SENTINEL_U32);
+    disc.a[0] = 20.0f;
+    CHECK_OK(mpca_world_add_body(w, &disc, still, 1.0f, &out));
+    disc.a[0] = 24.0f;
+    REFUSED(MPCA_STATUS_BODY_TABLE_FULL, mpca_world_add_body(w, &disc, still, 1.0f, &id));
+    CHECK_OK(mpca_world_remove_body(w, out));
 }
 
 static void obstacle_cases(void) {
@@ -1394,6 +1495,8 @@ static const struct {
     STATUS(MPCA_STATUS_IMAGE_INVALID),
     STATUS(MPCA_STATUS_IMAGE_MISMATCH),
     STATUS(MPCA_STATUS_IDS_EXHAUSTED),
+    STATUS(MPCA_STATUS_BODY_TABLE_FULL),
+    STATUS(MPCA_STATUS_NO_BODY),
     STATUS(MPCA_STATUS_UNKNOWN),
 };
 #define STATUS_COUNT (sizeof STATUSES / sizeof STATUSES[0])
@@ -1517,7 +1620,7 @@ static void message_cases(void) {
             CHECK(messages[j] == NULL || strcmp(messages[i], messages[j]) != 0);
         }
     }
-    const uint32_t unknown[] = {14, 99, 130, 139, 142, 198, 200, 1000, 0x7fffffffu, UINT32_MAX};
+    const uint32_t unknown[] = {14, 99, 130, 139, 144, 198, 200, 1000, 0x7fffffffu, UINT32_MAX};
     const char *first = TRACE(mpca_status_message(unknown[0]));
     CHECK(first != NULL && first[0] != '\0');
     for (unsigned i = 0; i < sizeof unknown / sizeof unknown[0] && first != NULL; i++) {
@@ -1581,6 +1684,7 @@ int main(void) {
     particle_cases();
     output_cases();
     identity_cases();
+    body_cases();
     handle_cases();
     message_cases();
     success_cases();
@@ -1591,6 +1695,7 @@ int main(void) {
     CHECK_OK(mpca_world_destroy(full3));
     CHECK_OK(mpca_world_destroy(bare2));
     CHECK_OK(mpca_world_destroy(emit2));
+    CHECK_OK(mpca_world_destroy(body2));
     free(full2_memory);
     free(small2_memory);
     free(pool);

@@ -295,12 +295,15 @@ static void round_trip(mpca_world *w, const char *name, uint64_t more) {
 
 /* The status a flip of a bit of byte `at` must give: the framing fields
  * are checked before the checksum, everything else by it. */
-static mpca_status flip_status(size_t at) {
+static mpca_status flip_status(const unsigned char *image, size_t at, unsigned bit) {
     if (at < VERSION_AT) {
         return MPCA_STATUS_NOT_AN_IMAGE;
     }
     if (at < RESERVED_AT) {
-        return MPCA_STATUS_IMAGE_VERSION;
+        /* A version this library reads (1, 2 or 3) goes on to the
+         * checksum, which the flip breaks. */
+        uint32_t version = get_u32(image + VERSION_AT) ^ (1u << (8 * (at - VERSION_AT) + bit));
+        return version >= 1 && version <= 3 ? MPCA_STATUS_IMAGE_CHECKSUM : MPCA_STATUS_IMAGE_VERSION;
     }
     if (at >= LENGTH_AT && at < HEAD_BYTES) {
         return MPCA_STATUS_IMAGE_LENGTH;
@@ -342,7 +345,7 @@ static void refusals(mpca_world *w2, unsigned char *w2_memory, size_t w2_bytes, 
         for (size_t at = 0; at < n; at++) {
             for (unsigned bit = 0; bit < 8; bit++) {
                 damaged[at] ^= (unsigned char)(1u << bit);
-                wrong += TRACE(mpca_world_load(target, damaged, n)) != flip_status(at);
+                wrong += TRACE(mpca_world_load(target, damaged, n)) != flip_status(image, at, bit);
                 damaged[at] ^= (unsigned char)(1u << bit);
                 cases++;
             }
@@ -356,7 +359,7 @@ static void refusals(mpca_world *w2, unsigned char *w2_memory, size_t w2_bytes, 
 
         check_context = "foreign images re-sealed";
         memcpy(damaged, image, n);
-        put_u32(damaged + VERSION_AT, 3);
+        put_u32(damaged + VERSION_AT, 4);
         reseal(damaged, n);
         REFUSED(MPCA_STATUS_IMAGE_VERSION, mpca_world_load(target, damaged, n));
         memcpy(damaged, image, n);

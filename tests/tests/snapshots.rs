@@ -254,12 +254,16 @@ fn truncations_of_the_scene_images_are_refused_and_change_nothing() {
     println!("scene images: {tried} truncations tried");
 }
 
-/// The error a flip of bit `bit` of byte `at` must give: the framing fields
-/// are checked before the checksum, everything else by it.
-fn flip_error(at: usize) -> Error {
+/// The error a flip of bit `bit` of byte `at` of `img` must give: the
+/// framing fields are checked before the checksum, everything else by it;
+/// a flipped version the library reads (1 to 3) goes on to the checksum.
+fn flip_error(img: &[u8], at: usize, bit: u32) -> Error {
     match at {
         0..VERSION_AT => Error::NotAnImage,
-        VERSION_AT..RESERVED_AT => Error::ImageVersion,
+        VERSION_AT..RESERVED_AT => {
+            let version = u32_at(img, VERSION_AT) ^ 1 << (8 * (at - VERSION_AT) as u32 + bit);
+            if (1..=IMAGE_VERSION).contains(&version) { Error::ImageChecksum } else { Error::ImageVersion }
+        }
         LENGTH_AT..DESC_AT => Error::ImageLength,
         _ => Error::ImageChecksum,
     }
@@ -274,7 +278,7 @@ fn every_single_bit_flip_of_a_small_image_is_refused_and_changes_nothing() {
     for at in 0..img.len() {
         for bit in 0..8 {
             damaged[at] ^= 1 << bit;
-            assert_eq!(target.load(&damaged), Err(flip_error(at)), "byte {at} bit {bit}");
+            assert_eq!(target.load(&damaged), Err(flip_error(&img, at, bit)), "byte {at} bit {bit}");
             assert_eq!(fingerprint(target), before, "byte {at} bit {bit}");
             damaged[at] ^= 1 << bit;
         }
@@ -299,7 +303,7 @@ fn bit_flips_in_a_large_image_are_refused() {
     for &at in &bytes {
         for bit in 0..8 {
             damaged[at] ^= 1 << bit;
-            assert_eq!(target.load(&damaged), Err(flip_error(at)), "byte {at} bit {bit}");
+            assert_eq!(target.load(&damaged), Err(flip_error(&img, at, bit)), "byte {at} bit {bit}");
             assert_eq!(target.state_hash(), before.hash, "byte {at} bit {bit}");
             damaged[at] ^= 1 << bit;
         }
@@ -314,8 +318,10 @@ fn the_image_head_is_little_endian_and_the_checksum_is_crc32() {
     let w = small_world(&mut memory, 25);
     let img = image(w);
     assert_eq!(&img[..8], b"MPCASNAP");
-    assert_eq!(u32_at(&img, VERSION_AT), IMAGE_VERSION);
-    assert_eq!(IMAGE_VERSION, 2);
+    // Version 2: a world without bodies is written as before they existed
+    // (version 3 is a world with bodies, M13).
+    assert_eq!(u32_at(&img, VERSION_AT), 2);
+    assert_eq!(IMAGE_VERSION, 3);
     assert_eq!(u32_at(&img, RESERVED_AT), 0);
     assert_eq!(u64_at(&img, LENGTH_AT), img.len() as u64);
     let n = img.len() - 4;
@@ -389,7 +395,8 @@ fn images_resealed_around_content_no_world_holds_are_refused() {
 
     type Edit = Box<dyn Fn(&mut Vec<u8>)>;
     let cases: Vec<(&str, Error, Edit)> = vec![
-        ("version 3", Error::ImageVersion, Box::new(move |i| set_u32(i, VERSION_AT, 3))),
+        ("version 4", Error::ImageVersion, Box::new(move |i| set_u32(i, VERSION_AT, 4))),
+        ("version 3 without bodies", Error::ImageInvalid, Box::new(move |i| set_u32(i, VERSION_AT, 3))),
         ("version 0", Error::ImageVersion, Box::new(move |i| set_u32(i, VERSION_AT, 0))),
         // Version 1's emitters are shorter: these do not add up.
         ("version 1", Error::ImageInvalid, Box::new(move |i| set_u32(i, VERSION_AT, 1))),
@@ -752,7 +759,7 @@ fn images_of_version_1_still_load() {
     assert_eq!(loaded.stats(), original.stats());
     assert_eq!(loaded.emitter_stats(0), Ok(mpca::EmitterStats::default()));
     let again = image(loaded);
-    assert_eq!((u32_at(&again, VERSION_AT), again.len()), (IMAGE_VERSION, v1.len() + 16));
+    assert_eq!((u32_at(&again, VERSION_AT), again.len()), (2, v1.len() + 16));
     // The two count on from where each stands: by the same amounts.
     let at_20 = original.emitter_stats(0).unwrap();
     original.step(15);

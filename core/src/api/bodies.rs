@@ -65,10 +65,8 @@ impl Draw<'_> {
     /// The body that covers cell `c`: the first in table order whose shape
     /// holds its centre, unless a static obstacle does.
     pub(crate) fn owner(&self, c: [usize; 3]) -> Option<(usize, Body)> {
-        if (self.is_static)(c) {
-            return None;
-        }
-        (0..self.count).map(|i| (i, (self.body)(i))).find(|(_, b)| b.shape().is_some_and(|s| s.contains(centre(c), self.frame.dim)))
+        let first = (0..self.count).map(|i| (i, (self.body)(i))).find(|(_, b)| b.shape().is_some_and(|s| s.contains(centre(c), self.frame.dim)));
+        first.filter(|_| !(self.is_static)(c))
     }
 
     /// The box of cells, per axis `lo..hi`, that holds every body's cells.
