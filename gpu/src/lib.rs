@@ -170,8 +170,7 @@ impl Gpu {
 
 /// Why this backend cannot run a description: `None` where it can.
 pub fn unsupported(d: &Description) -> Option<&'static str> {
-    let checks: [(bool, &'static str); 2] = [
-        (d.dim == 2 || d.method != Method::ExactFast, "exact-fast assignment in 3D"),
+    let checks: [(bool, &'static str); 1] = [
         // Correct where loops are not limited, but a dense 3D block's search
         // (8! leaves) runs past the loop limit of Mesa's lavapipe, which
         // ends a shader's loops after 65,535 iterations in all: untested.
