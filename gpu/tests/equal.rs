@@ -780,3 +780,11 @@ fn forces_masses_and_collision_rules_step_as_on_the_cpu_in_3d() {
         same_worlds(&mut w, 16, 1);
     }
 }
+
+#[test]
+fn the_papers_water_scene_steps_as_on_the_cpu() {
+    // 4.4: 3D 64^3, walls all round, gravity, a sphere obstacle, an
+    // emitter with a spread, exact-fast assignment and 8-bit velocities;
+    // 130 steps, compared every 10.
+    same_scene(mpca_tests::scenes::water(), 10);
+}
