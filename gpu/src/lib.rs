@@ -19,8 +19,10 @@
 //! (M5.6), contacts (M5.7), energy-neutral rounding (M1b), emitters and
 //! lifetimes (M6), ids, ages and tags (M6b): the paper's aggregation,
 //! cluster and smoke scenes, the smoke with flow drag and the benchmark's
-//! gas. A 3D description is refused when the world is made, as a CPU build
-//! without `dim3` refuses it ([`mpca::Error::FeatureDisabled`]).
+//! gas. In 3D the same parts run with exact-fast or greedy assignment: the
+//! paper's water scene among them. 3D exhaustive assignment is refused when
+//! the world is made ([`mpca::Error::FeatureDisabled`]; [`unsupported`]
+//! names it).
 //!
 //! ```
 //! use mpca::{Description, WorldBox};
