@@ -38,8 +38,13 @@ impl Exports {
     /// The exports of `world`, with a texel of `density` for each `tile x
     /// tile` cells (a power of two; the texture is rounded up to whole
     /// texels). Refused with `BadResolution` for another tile, or one that
-    /// leaves the texture larger than the device allows.
+    /// leaves the texture larger than the device allows, and with
+    /// `FeatureDisabled` for a 3D world (the passes read 2D planes).
     pub fn new(world: &GpuWorld, tile: u32) -> Result<Exports, Error> {
+        // The exports read the 2D planes' layout.
+        if world.host.description().dim != 2 {
+            return Err(Error::World(mpca::Error::FeatureDisabled));
+        }
         let device = &world.gpu.device;
         let [nx, ny, _] = world.host.description().size;
         let size = [nx.div_ceil(tile.max(1)), ny.div_ceil(tile.max(1))];
