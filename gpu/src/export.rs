@@ -22,7 +22,8 @@ pub struct Exports {
     /// (cells a step), alpha 1. Filterable, so a sampler smooths it.
     pub density: wgpu::Texture,
     /// The particles `particles` holds room for: the world's count when
-    /// the exports were made (no part this backend runs adds particles).
+    /// the exports were made. Particles beyond it (emitters add them) are
+    /// left out of `particles` and the draw; exports made again take them.
     pub capacity: u64,
     /// Cells along a side of a texel of `density`.
     pub tile: u32,
