@@ -22,7 +22,8 @@ pub struct Exports {
     /// (cells a step), alpha 1. Filterable, so a sampler smooths it.
     pub density: wgpu::Texture,
     /// The particles `particles` holds room for: the world's count when
-    /// the exports were made (no part this backend runs adds particles).
+    /// the exports were made. Particles beyond it (emitters add them) are
+    /// left out of `particles` and the draw; exports made again take them.
     pub capacity: u64,
     /// Cells along a side of a texel of `density`.
     pub tile: u32,
@@ -38,8 +39,13 @@ impl Exports {
     /// The exports of `world`, with a texel of `density` for each `tile x
     /// tile` cells (a power of two; the texture is rounded up to whole
     /// texels). Refused with `BadResolution` for another tile, or one that
-    /// leaves the texture larger than the device allows.
+    /// leaves the texture larger than the device allows, and with
+    /// `FeatureDisabled` for a 3D world (the passes read 2D planes).
     pub fn new(world: &GpuWorld, tile: u32) -> Result<Exports, Error> {
+        // The exports read the 2D planes' layout.
+        if world.host.description().dim != 2 {
+            return Err(Error::World(mpca::Error::FeatureDisabled));
+        }
         let device = &world.gpu.device;
         let [nx, ny, _] = world.host.description().size;
         let size = [nx.div_ceil(tile.max(1)), ny.div_ceil(tile.max(1))];

@@ -1,5 +1,5 @@
 //! The block rule of `mpca` on the GPU: a [`GpuWorld`] steps a world in a
-//! WGSL compute shader (`step2d.wgsl`) and stays equal to the CPU's world
+//! WGSL compute shader (`rule.wgsl`) and stays equal to the CPU's world
 //! bit for bit (M8b in `docs/model.md`): the same hash, counters and
 //! snapshot image after every step.
 //!
@@ -19,8 +19,10 @@
 //! (M5.6), contacts (M5.7), energy-neutral rounding (M1b), emitters and
 //! lifetimes (M6), ids, ages and tags (M6b): the paper's aggregation,
 //! cluster and smoke scenes, the smoke with flow drag and the benchmark's
-//! gas. A 3D description is refused when the world is made, as a CPU build
-//! without `dim3` refuses it ([`mpca::Error::FeatureDisabled`]).
+//! gas. In 3D the same parts run with exact-fast or greedy assignment: the
+//! paper's water scene among them. 3D exhaustive assignment is refused when
+//! the world is made ([`mpca::Error::FeatureDisabled`]; [`unsupported`]
+//! names it).
 //!
 //! ```
 //! use mpca::{Description, WorldBox};
@@ -46,7 +48,7 @@ mod export;
 
 pub use export::Exports;
 use mpca::port::{DragConstants, PortPlanes, StepConstants, StepCounts, VortexConstants};
-use mpca::{Boundary, Collisions, Description, Drift, Quantization, World, WorldBox};
+use mpca::{Boundary, Collisions, Description, Drift, Method, Quantization, World, WorldBox};
 use wgpu::util::DeviceExt;
 
 /// Why a GPU world could not be made or stepped.
@@ -93,22 +95,32 @@ pub struct Gpu {
     pub queue: wgpu::Queue,
     /// The adapter's name and driver, where this made the device.
     pub adapter: String,
-    /// The step's pipelines, compiled for the first world made on this
-    /// device and shared by every other (clones of a `Gpu` share them).
-    pipelines: std::sync::Arc<std::sync::OnceLock<Pipelines>>,
+    /// The step's pipelines of each dimension (2D first), compiled for the
+    /// first world of that dimension made on this device and shared by
+    /// every other (clones of a `Gpu` share them).
+    pipelines: std::sync::Arc<[std::sync::OnceLock<Pipelines>; 2]>,
 }
 
-/// The compute pipelines of `step2d.wgsl`: the sweep, the end of a step,
-/// the emitters.
+/// The compute pipelines of the rule (`rule.wgsl`) in one dimension: the
+/// sweep, the end of a step, the emitters.
 struct Pipelines {
     step: wgpu::ComputePipeline,
     end: wgpu::ComputePipeline,
     emit: wgpu::ComputePipeline,
 }
 
+/// The shader of each dimension: what the dimension does its own way,
+/// then the rule both share, written once.
+const SHADERS: [(&str, &str); 2] = [
+    ("step2d.wgsl, rule.wgsl", concat!(include_str!("step2d.wgsl"), include_str!("rule.wgsl"))),
+    ("step3d.wgsl, rule.wgsl", concat!(include_str!("step3d.wgsl"), include_str!("rule.wgsl"))),
+];
+
 impl Pipelines {
-    fn of(device: &wgpu::Device) -> Pipelines {
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some("step2d.wgsl"), source: wgpu::ShaderSource::Wgsl(include_str!("step2d.wgsl").into()) });
+    /// The pipelines of a world of `dim` dimensions.
+    fn of(device: &wgpu::Device, dim: u32) -> Pipelines {
+        let (label, source) = SHADERS[dim as usize - 2];
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some(label), source: wgpu::ShaderSource::Wgsl(source.into()) });
         let pipeline = |entry: &str| {
             device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                 label: Some(entry),
@@ -119,7 +131,7 @@ impl Pipelines {
                 cache: None,
             })
         };
-        Pipelines { step: pipeline("step_2d"), end: pipeline("end_step"), emit: pipeline("emit") }
+        Pipelines { step: pipeline("sweep"), end: pipeline("end_step"), emit: pipeline("emit") }
     }
 }
 
@@ -161,7 +173,10 @@ impl Gpu {
 /// Why this backend cannot run a description: `None` where it can.
 pub fn unsupported(d: &Description) -> Option<&'static str> {
     let checks: [(bool, &'static str); 2] = [
-        (d.dim == 2, "3D worlds"),
+        // Correct where loops are not limited, but a dense 3D block's search
+        // (8! leaves) runs past the loop limit of Mesa's lavapipe, which
+        // ends a shader's loops after 65,535 iterations in all: untested.
+        (d.dim == 2 || d.method != Method::Exhaustive, "exhaustive assignment in 3D"),
         (!(d.obstacles && d.body_capacity > 0), "bodies, obstacles the caller moves (M13)"),
     ];
     checks.iter().find(|(ok, _)| !ok).map(|(_, what)| *what)
@@ -204,6 +219,8 @@ fn tables(moves: &[u16; 256]) -> Vec<u32> {
 const COUNTERS: usize = 22;
 /// Where the last id given lies in the counters.
 const IDS_GIVEN: usize = 21;
+/// Words a surface entry takes in the shader's surface table.
+const SURFACE: usize = 5;
 /// Words an emitter takes in the shader's emitter table.
 const EMITTER: usize = 16;
 /// The counters a sync takes into the CPU copy and clears: all but the
@@ -222,7 +239,7 @@ pub struct GpuWorld {
     /// Steps run on the GPU since the last sync.
     pending: u64,
     pipeline: wgpu::ComputePipeline,
-    /// The world's integers and the rule's tables (`step2d.wgsl`), written
+    /// The world's integers and the rule's tables (`rule.wgsl`), written
     /// again when an image brings another description.
     params: wgpu::Buffer,
     tables: wgpu::Buffer,
@@ -274,7 +291,7 @@ impl GpuWorld {
         host.load(&image)?;
         let device = &gpu.device;
         let desc = *host.description();
-        let (nx, ny) = (desc.size[0], desc.size[1]);
+        let [nx, ny, nz] = desc.size;
         let c = Contents::of(&host);
         let storage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
         let buffer = |label: &str, bytes: &[u8]| device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents: bytes, usage: storage });
@@ -286,7 +303,7 @@ impl GpuWorld {
         let counters = buffer("counters", &c.counters);
         let params = buffer("params", &c.params);
         let tables = buffer("tables", &c.tables);
-        let shared = gpu.pipelines.get_or_init(|| Pipelines::of(device));
+        let shared = gpu.pipelines[desc.dim as usize - 2].get_or_init(|| Pipelines::of(device, desc.dim));
         let (pipeline, end) = (shared.step.clone(), shared.end.clone());
         let emitters = buffer("emitters", &c.emitters);
         let emitter_stats = buffer("emitter stats", &c.emitter_stats);
@@ -338,8 +355,9 @@ impl GpuWorld {
             groups,
             current: 0,
             // At offset 1 a face that is not periodic has a half block
-            // more (the shader skips the row where it has not).
-            dispatch: [words.div_ceil(64), ny / 2 + 1],
+            // more (the shader skips the row where it has not); rows of
+            // blocks along y, then z.
+            dispatch: [words.div_ceil(64), (ny / 2 + 1) * if desc.dim == 3 { nz / 2 + 1 } else { 1 }],
         })
     }
 
@@ -419,7 +437,7 @@ impl GpuWorld {
     pub fn sync(&mut self) -> Result<&World, Error> {
         if self.pending > 0 {
             let occupancy: Vec<u64> = self.gpu.read(&self.occupancy[self.current]).chunks_exact(8).map(|b| u64::from_le_bytes(b.try_into().expect("8 bytes"))).collect();
-            let mut velocity = self.gpu.read(&self.velocity[self.current]);
+            let velocity = self.gpu.read(&self.velocity[self.current]);
             let mut life = self.gpu.read(&self.life[self.current]);
             let mass = self.gpu.read(&self.mass[self.current]);
             let ident = self.gpu.read(&self.ident[self.current]);
@@ -429,7 +447,7 @@ impl GpuWorld {
             let emitted: Vec<mpca::EmitterStats> = (0..emitters).map(|i| mpca::EmitterStats { requested: stats[2 * i], delivered: stats[2 * i + 1] }).collect();
             // The buffers are padded to whole words.
             let planes = self.host.port_planes();
-            velocity.truncate(planes.velocity.len());
+            let velocity = from_gpu_velocity(self.host.description(), &velocity, planes.velocity.len());
             life.truncate(planes.life.len());
             // 16 bits a cell on the GPU, a byte each in the world; ids and
             // ages interleaved on the GPU.
@@ -497,11 +515,11 @@ impl Contents {
         let f = host.port_fields();
         let words = |w: &[u32]| padded(bytemuck::cast_slice(w));
         let mut surfaces = surface_table(host);
-        let count = surfaces.len() / 4;
-        surfaces.resize(4 * (desc.surface_capacity as usize).max(1), 0);
+        let count = surfaces.len() / SURFACE;
+        surfaces.resize(SURFACE * (desc.surface_capacity as usize).max(1), 0);
         let capacity = desc.emitter_capacity as usize;
         Contents {
-            planes: [padded(bytemuck::cast_slice(p.occupancy)), padded(p.velocity), padded(p.life), padded(&carried(&p)), padded(&identities(&p))],
+            planes: [padded(bytemuck::cast_slice(p.occupancy)), padded(&to_gpu_velocity(desc, p.velocity)), padded(p.life), padded(&carried(&p)), padded(&identities(&p))],
             classes: words(&class_table(host)),
             fields: [f.force, f.potential, f.wind].map(padded),
             obstacles: padded(bytemuck::cast_slice(host.port_obstacles())),
@@ -523,9 +541,34 @@ fn padded(bytes: &[u8]) -> Vec<u8> {
 }
 
 /// The surface entries of `host`'s obstacles as the shader reads them
-/// (`step2d.wgsl`): cell, normal x and y in Q30, restitution in Q16.
+/// (`rule.wgsl`): cell, normal x, y and z in Q30, restitution in Q16.
 fn surface_table(host: &World) -> Vec<u32> {
-    (0..).map_while(|i| host.port_surface(i)).flat_map(|e| [e.cell, e.normal[0] as u32, e.normal[1] as u32, e.restitution as u32]).collect()
+    (0..).map_while(|i| host.port_surface(i)).flat_map(|e| [e.cell, e.normal[0] as u32, e.normal[1] as u32, e.normal[2] as u32, e.restitution as u32]).collect()
+}
+
+/// Bytes a cell's stored velocity takes in the world's plane (`dim`
+/// components of one or two bytes) and in the shader's: the same in 2D; a
+/// word (8-bit) or two (16-bit) in 3D (`rule.wgsl`).
+fn velocity_strides(d: &Description) -> (usize, usize) {
+    let bytes = if d.quantization == Quantization::Bits16 { 2 } else { 1 };
+    let cpu = d.dim as usize * bytes;
+    (cpu, if d.dim == 3 { 4 * bytes } else { cpu })
+}
+
+/// The world's velocity plane as the shader keeps it.
+fn to_gpu_velocity(d: &Description, plane: &[u8]) -> Vec<u8> {
+    let (cpu, gpu) = velocity_strides(d);
+    plane.chunks_exact(cpu).flat_map(|cell| {
+        let mut out = [0u8; 8];
+        out[..cpu].copy_from_slice(cell);
+        out.into_iter().take(gpu)
+    }).collect()
+}
+
+/// The shader's velocity plane (padded) as the world keeps it, `len` bytes.
+fn from_gpu_velocity(d: &Description, plane: &[u8], len: usize) -> Vec<u8> {
+    let (cpu, gpu) = velocity_strides(d);
+    plane.chunks_exact(gpu).flat_map(|cell| cell[..cpu].iter().copied()).take(len).collect()
 }
 
 /// What the shader keeps of a world's mass indices and tags: 16 bits a
@@ -545,7 +588,7 @@ fn identities(p: &PortPlanes<'_>) -> Vec<u8> {
     (0..cells).flat_map(|i| [word(p.id, i), word(p.age, i)].concat()).collect()
 }
 
-/// The shader's class table (`step2d.wgsl`): for each of the 256 mass
+/// The shader's class table (`rule.wgsl`): for each of the 256 mass
 /// indices its class (M1c) as 8 words.
 fn class_table(host: &World) -> Vec<u32> {
     (0..=255u8)
@@ -562,13 +605,13 @@ fn emitter_count(host: &World) -> usize {
     (0..).take_while(|&i| host.port_emitter(i).is_some()).count()
 }
 
-/// The shader's emitter table (`step2d.wgsl`, M6) for `capacity`
+/// The shader's emitter table (`rule.wgsl`, M6) for `capacity`
 /// emitters, those of `host` first.
 fn emitter_table(host: &World, capacity: usize) -> Vec<u32> {
     let mut table = vec![0u32; EMITTER * capacity];
     for (i, entry) in table.chunks_exact_mut(EMITTER).enumerate() {
         let Some(e) = host.port_emitter(i) else { break };
-        entry[..13].copy_from_slice(&[e.min[0], e.min[1], e.max[0], e.max[1], e.whole as u32, (e.whole >> 32) as u32, e.threshold, e.velocity[0] as u32, e.velocity[1] as u32, e.radius as u32, e.lifetime, u32::from(e.mass_index), u32::from(e.tag)]);
+        entry.copy_from_slice(&[e.min[0], e.min[1], e.min[2], e.max[0], e.max[1], e.max[2], e.whole as u32, (e.whole >> 32) as u32, e.threshold, e.velocity[0] as u32, e.velocity[1] as u32, e.velocity[2] as u32, e.radius as u32, e.lifetime, u32::from(e.mass_index), u32::from(e.tag)]);
     }
     table
 }
@@ -583,7 +626,7 @@ fn counters_of(host: &World) -> [u32; COUNTERS] {
     counters
 }
 
-/// The shader's parameters (`step2d.wgsl`).
+/// The shader's parameters (`rule.wgsl`).
 const PARAMS: usize = 55;
 
 /// A face as the shader reads it: 0 periodic, 1 wall, 2 open.
@@ -595,14 +638,14 @@ fn face(b: Boundary) -> u32 {
     }
 }
 
-/// The shader's parameters, the same every step (`step2d.wgsl`), from
+/// The shader's parameters, the same every step (`rule.wgsl`), from
 /// the world's constants `c`; what depends on the mass is in the class
 /// table ([`class_table`]).
 fn params(c: &StepConstants, d: &Description, d_emitters: u32, surfaces: u32) -> [u32; PARAMS] {
     let lo = |x: u64| x as u32;
     let hi = |x: u64| (x >> 32) as u32;
-    let (nx, ny) = (d.size[0], d.size[1]);
-    let faces = face(d.boundary[0][0]) | face(d.boundary[0][1]) << 2 | face(d.boundary[1][0]) << 4 | face(d.boundary[1][1]) << 6;
+    let [nx, ny, nz] = d.size;
+    let faces = (0..d.dim as usize).map(|k| (face(d.boundary[k][0]) | face(d.boundary[k][1]) << 2) << (4 * k)).fold(0, |all, f| all | f);
     let g = c.push.map(|g| g as u64);
     let v = c.vortex.unwrap_or(VortexConstants { centre: [0; 2], core: 0, flow: None });
     let flow = v.flow.unwrap_or_default();
@@ -611,7 +654,7 @@ fn params(c: &StepConstants, d: &Description, d_emitters: u32, surfaces: u32) ->
     [
         lo(d.seed),
         hi(d.seed),
-        0,
+        nz,
         0,
         0,
         0,
@@ -621,7 +664,7 @@ fn params(c: &StepConstants, d: &Description, d_emitters: u32, surfaces: u32) ->
         u32::from(d.quantization == Quantization::Bits16),
         c.restitution as u32,
         c.unit as u32,
-        0,
+        drag.wind[2] as u32,
         0,
         faces,
         c.wall_restitution as u32,

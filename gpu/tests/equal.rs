@@ -25,23 +25,45 @@ fn gas_around(nx: u32, ny: u32, density: f64, seed: u64, edit: impl Fn(&mut Desc
     let mut desc = Description::new_2d(nx, ny);
     desc.seed = seed;
     edit(&mut desc);
-    let mut w = WorldBox::new(&desc).unwrap();
+    filled(&desc, density, place)
+}
+
+/// A 3D gas of `size` cells at `density`, velocities uniform in the cube
+/// [-1, 1]^3 cut to the unit ball, from `seed`, in a world that `place`
+/// gives obstacles first.
+fn gas_3d(size: [u32; 3], density: f64, seed: u64, edit: impl Fn(&mut Description), place: impl Fn(&mut World)) -> WorldBox {
+    let mut desc = Description::new_3d(size[0], size[1], size[2]);
+    desc.seed = seed;
+    edit(&mut desc);
+    filled(&desc, density, place)
+}
+
+/// A world of `desc` that `place` gives obstacles, then a particle in each
+/// free cell with probability `density`, velocities uniform in the square
+/// or cube cut to the unit disc or ball, from the description's seed.
+fn filled(desc: &Description, density: f64, place: impl Fn(&mut World)) -> WorldBox {
+    let mut w = WorldBox::new(desc).unwrap();
     place(&mut w);
-    let mut rng = mpca::rng::block_stream(seed, 99, 0);
-    for y in 0..ny {
-        for x in 0..nx {
-            if f64::from(rng.bits(24)) < density * 16_777_216.0 {
-                let mut v = [0f32; 3];
-                loop {
-                    v[0] = rng.bits(16) as f32 / 32768.0 - 1.0;
-                    v[1] = rng.bits(16) as f32 / 32768.0 - 1.0;
-                    if v[0] * v[0] + v[1] * v[1] <= 0.98 {
-                        break;
+    let mut rng = mpca::rng::block_stream(desc.seed, 99, 0);
+    let dim = desc.dim as usize;
+    let [nx, ny, nz] = desc.size;
+    for z in 0..nz {
+        for y in 0..ny {
+            for x in 0..nx {
+                if f64::from(rng.bits(24)) < density * 16_777_216.0 {
+                    let mut v = [0f32; 3];
+                    loop {
+                        for c in &mut v[..dim] {
+                            *c = rng.bits(16) as f32 / 32768.0 - 1.0;
+                        }
+                        if v.iter().map(|c| c * c).sum::<f32>() <= 0.98 {
+                            break;
+                        }
                     }
-                }
-                match w.add_particle([x, y, 0], v) {
-                    Ok(()) | Err(mpca::Error::CellObstacle) => {}
-                    Err(e) => panic!("{e:?}"),
+                    match w.add_particle([x, y, z], v) {
+                        Ok(()) | Err(mpca::Error::CellObstacle) => {}
+                        Err(e) => panic!("{e:?}"),
+                    }
                 }
             }
         }
@@ -107,14 +129,41 @@ fn many_steps_between_syncs_step_as_on_the_cpu() {
 #[test]
 fn a_part_the_backend_does_not_run_is_refused() {
     let gpu = gpu();
-    let w = WorldBox::new(&Description::new_3d(8, 8, 8)).unwrap();
+    let mut d = Description::new_3d(8, 8, 8);
+    d.method = mpca::Method::Exhaustive;
+    let w = WorldBox::new(&d).unwrap();
     assert!(matches!(GpuWorld::new(&gpu, &w), Err(mpca_gpu::Error::World(mpca::Error::FeatureDisabled))));
-    assert_eq!(mpca_gpu::unsupported(w.description()), Some("3D worlds"));
+    assert_eq!(mpca_gpu::unsupported(w.description()), Some("exhaustive assignment in 3D"));
     let mut d = Description::new_2d(16, 16);
     (d.obstacles, d.body_capacity, d.body_surface_capacity) = (true, 1, 64);
     let w = WorldBox::new(&d).unwrap();
     assert!(matches!(GpuWorld::new(&gpu, &w), Err(mpca_gpu::Error::World(mpca::Error::FeatureDisabled))));
     assert_eq!(mpca_gpu::unsupported(w.description()), Some("bodies, obstacles the caller moves (M13)"));
+}
+
+#[test]
+fn a_3d_gas_steps_as_on_the_cpu() {
+    // Periodic 3D gases with exact-fast (M5.6: its direct cases, the
+    // Hungarian method and the count of optima in dense blocks) and greedy
+    // assignment, at both widths: blocks of four rows (y, z), the blocks
+    // that straddle 32-cell words and wrap round x, y and z, densities up
+    // to full blocks.
+    use mpca::Method::{ExactFast, Greedy};
+    for (size, density, method, quantization) in [
+        ([16, 8, 8], 0.3, Greedy, mpca::Quantization::Bits8),
+        ([16, 8, 8], 0.3, ExactFast, mpca::Quantization::Bits8),
+        ([2, 2, 2], 0.6, ExactFast, mpca::Quantization::Bits8),
+        ([66, 6, 4], 0.5, Greedy, mpca::Quantization::Bits16),
+        ([34, 4, 6], 0.8, ExactFast, mpca::Quantization::Bits8),
+        ([20, 6, 6], 0.6, ExactFast, mpca::Quantization::Bits16),
+    ] {
+        let mut w = gas_3d(size, density, u64::from(size[0]), |d| {
+            d.method = method;
+            d.quantization = quantization;
+            d.restitution = 0.8;
+        }, |_| {});
+        same_worlds(&mut w, 12, 1);
+    }
 }
 
 /// A scene of the paper as the paper ran it, compared every `every` steps.
@@ -619,4 +668,128 @@ fn exhaustive_and_greedy_assignments_step_as_on_the_cpu() {
         );
         same_worlds(&mut w, 30, 1);
     }
+}
+
+#[test]
+fn walls_open_faces_and_gravity_step_as_on_the_cpu_in_3d() {
+    // Mixes of wall, open and periodic axes in 3D (edges and corners
+    // beyond two and three walls, with their diagonal normals, and walls
+    // beside open faces), with a uniform force strong enough to clamp, at
+    // both widths and at sizes whose half blocks cross words.
+    use mpca::Boundary::{Open, Periodic, Wall};
+    let faces = [[[Wall, Wall], [Wall, Wall], [Wall, Wall]], [[Open, Wall], [Wall, Open], [Periodic, Periodic]], [[Periodic, Periodic], [Wall, Wall], [Open, Wall]]];
+    for (i, f) in faces.into_iter().enumerate() {
+        for (size, quantization) in [([8, 6, 4], mpca::Quantization::Bits8), ([34, 4, 6], mpca::Quantization::Bits16)] {
+            let mut w = gas_3d(size, 0.4, 130 + i as u64, |d| {
+                d.boundary = f;
+                d.wall_restitution = 0.7;
+                d.method = mpca::Method::Greedy;
+                d.quantization = quantization;
+                d.forces.uniform = true;
+                d.gravity = [0.02, -0.3, 0.4];
+            }, |_| {});
+            same_worlds(&mut w, 12, 1);
+        }
+    }
+}
+
+#[test]
+fn obstacles_emitters_and_identity_step_as_on_the_cpu_in_3d() {
+    // M5.4 off 3D obstacles (a sphere, a box, a tilted half-space, a mask
+    // blob, a cell with its own normal) in a walled box under gravity, an
+    // emitter over obstacle cells with a spread and a lifetime (M6), ids,
+    // ages and tags (M6b), contacts (M5.7); at both widths.
+    use mpca::Shape;
+    for quantization in [mpca::Quantization::Bits8, mpca::Quantization::Bits16] {
+        let mut w = gas_3d(
+            [36, 16, 12],
+            0.25,
+            141,
+            |d| {
+                d.quantization = quantization;
+                d.method = mpca::Method::Greedy;
+                d.boundary = [[mpca::Boundary::Periodic; 2], [mpca::Boundary::Wall; 2], [mpca::Boundary::Wall, mpca::Boundary::Open]];
+                d.obstacles = true;
+                d.surface_capacity = 3000;
+                d.forces.uniform = true;
+                d.gravity = [0.0, -0.01, 0.003];
+                d.wall_restitution = 0.6;
+                d.restitution = 0.7;
+                d.contacts = true;
+                d.emitter_capacity = 1;
+                d.lifetimes = true;
+                d.identity = mpca::Identity::ALL;
+            },
+            |w| {
+                w.add_shape(Shape::Sphere { centre: [9.0, 8.0, 6.0], radius: 3.5 }, 0.9).unwrap();
+                w.add_shape(Shape::Box { min: [20.0, 2.0, 3.0], max: [25.0, 7.0, 8.0] }, 0.3).unwrap();
+                w.add_shape(Shape::HalfSpace { point: [0.0, 3.0, 0.0], normal: [0.2, 0.95, -0.2] }, 0.7).unwrap();
+                let mut mask = vec![0u8; 36 * 16 * 12];
+                for (i, m) in mask.iter_mut().enumerate() {
+                    let (x, y, z) = ((i % 36) as i32 - 30, (i / 36 % 16) as i32 - 11, (i / 576) as i32 - 6);
+                    *m = u8::from(x * x + 2 * y * y + z * z <= 6);
+                }
+                w.add_obstacle_mask(&mask, 1.0).unwrap();
+                w.add_obstacle([15, 12, 2], [0.6, -0.8, 0.0], 0.5).unwrap();
+                w.add_emitter(mpca::Emitter { min: [6, 10, 3], max: [14, 14, 9], rate: 3.5, velocity: [0.1, -0.3, 0.2], spread: 0.25, mass: 1.0, lifetime: 9 }).unwrap();
+            },
+        );
+        same_worlds(&mut w, 24, 1);
+        assert!(w.stats().expired > 0 && w.stats().exited > 0, "particles expire and leave: {:?}", w.stats());
+    }
+}
+
+#[test]
+fn forces_masses_and_collision_rules_step_as_on_the_cpu_in_3d() {
+    // Every force term in 3D (a force field and a potential from random
+    // planes, the vortex about z, drag towards a uniform wind, the wind
+    // plane and the vortex as a flow), five masses, speed-limited
+    // collisions and energy-neutral rounding; walls on y, at both widths.
+    for quantization in [mpca::Quantization::Bits8, mpca::Quantization::Bits16] {
+        let size = [18u32, 10, 8];
+        let masses = [1.0f32, 40.0, 0.001, 2.5, 7.0];
+        let mut w = gas_3d(
+            size,
+            0.0,
+            151,
+            |d| {
+                d.quantization = quantization;
+                d.method = mpca::Method::Greedy;
+                d.boundary[1] = [mpca::Boundary::Wall; 2];
+                d.forces = mpca::Forces { uniform: true, field: true, potential: true, vortex: true };
+                d.gravity = [0.0, 0.004, -0.002];
+                d.vortex = mpca::Vortex { centre: [9.0, 5.5], core_radius: 3.0, circulation: 2.5 };
+                d.drag = mpca::Drag { rate: 0.2, wind: [0.1, -0.05, 0.07], field: true, vortex: true };
+                d.per_particle_mass = true;
+                d.mass_classes = 8;
+                d.collisions = mpca::Collisions::SpeedLimited;
+                d.energy_neutral = true;
+            },
+            |_| {},
+        );
+        let mut rng = mpca::rng::block_stream(152, 0, 0);
+        let cells = (size[0] * size[1] * size[2]) as usize;
+        for i in 0..cells as u32 {
+            if rng.bits(8) < 100 {
+                let v = [0, 1, 2].map(|_| rng.bits(16) as f32 / 65536.0 - 0.5);
+                w.add_particle_with_mass([i % size[0], i / size[0] % size[1], i / (size[0] * size[1])], v, masses[rng.below(5) as usize]).unwrap();
+            }
+        }
+        let mut value = |scale: f32| (rng.bits(16) as f32 / 32768.0 - 1.0) * scale;
+        let force: Vec<f32> = (0..3 * cells).map(|i| value(if i % 97 == 0 { 1e30 } else { 0.02 })).collect();
+        let potential: Vec<f32> = (0..cells).map(|_| value(0.05)).collect();
+        let wind: Vec<f32> = (0..cells).flat_map(|_| [value(0.3), value(0.3), value(0.3)]).collect();
+        w.set_force_field(&force).unwrap();
+        w.set_potential(&potential).unwrap();
+        w.set_wind_field(&wind).unwrap();
+        same_worlds(&mut w, 16, 1);
+    }
+}
+
+#[test]
+fn the_papers_water_scene_steps_as_on_the_cpu() {
+    // 4.4: 3D 64^3, walls all round, gravity, a sphere obstacle, an
+    // emitter with a spread, exact-fast assignment and 8-bit velocities;
+    // 130 steps, compared every 10.
+    same_scene(mpca_tests::scenes::water(), 10);
 }

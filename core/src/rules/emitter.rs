@@ -116,18 +116,21 @@ pub(crate) fn split_rate(rate: f32) -> (u64, u32) {
         let whole = if e > 40 { u64::MAX } else { m << e };
         return (whole, 0);
     }
-    let point = (-e) as u32;
+    // With a fraction the whole part is below the mantissa's 2^24, and
+    // so is all that follows: 32 bits (on a small core 64-bit shifts are
+    // library calls).
+    let (m, point) = (m as u32, (-e) as u32);
     let whole = m.checked_shr(point).unwrap_or(0);
-    let fraction = m - (whole << point.min(63));
+    let fraction = m - (whole << point.min(31));
     // The fraction's bits at 2^24, rounded up.
     let threshold = if point <= 24 {
         fraction << (24 - point)
     } else {
         let cut = point - 24;
         let kept = fraction.checked_shr(cut).unwrap_or(0);
-        kept + u64::from(kept.checked_shl(cut).unwrap_or(0) != fraction)
+        kept + u32::from(kept.checked_shl(cut).unwrap_or(0) != fraction)
     };
-    (whole, threshold as u32)
+    (u64::from(whole), threshold)
 }
 
 /// M6: an emitted particle's velocity in fine units of a world of `unit`

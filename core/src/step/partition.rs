@@ -135,9 +135,11 @@ impl Partition {
         Partition { offset, axes: [axis(0), axis(1), axis(2)], dim, row_words: layout.row_words, summary_words: layout.summary_words }
     }
 
-    /// Blocks in the grid, occupied or not.
+    /// Blocks in the grid, occupied or not. Multiplied in machine words:
+    /// an axis has no more blocks than cells (`n / 2 + 1 <= n`), and the
+    /// cells fit a `u32` (`Layout::of`), so the product does too.
     pub fn total_blocks(&self) -> u64 {
-        self.axes.iter().map(|a| a.blocks as u64).product()
+        self.axes.iter().map(|a| a.blocks).product::<usize>() as u64
     }
 
     /// The coordinates of cell `c` of a block of `row` whose x coordinates
