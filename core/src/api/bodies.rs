@@ -136,7 +136,7 @@ impl World {
     pub fn add_body(&mut self, shape: Shape, u: [f32; 3], e: f32) -> Result<u32, Error> {
         let (_, table) = self.bodies()?;
         let slot = table.iter().position(|b| b.kind == 0).ok_or(Error::BodyTableFull)?;
-        let body = self.checked_body(Body::new(shape, u, e, self.dim())?);
+        let body = self.with_fine_velocity(Body::new(shape, u, e, self.dim())?);
         self.redraw(Change { slot, body })?;
         Ok(slot as u32)
     }
@@ -146,7 +146,7 @@ impl World {
     pub fn move_body(&mut self, id: u32, shape: Shape, u: [f32; 3]) -> Result<(), Error> {
         let mut body = self.body(id)?;
         body.set(shape, u, self.dim())?;
-        let body = self.checked_body(body);
+        let body = self.with_fine_velocity(body);
         self.redraw(Change { slot: id as usize, body })
     }
 
@@ -185,7 +185,7 @@ impl World {
         let count = self.head.desc.body_capacity as usize;
         for i in 0..count {
             let b = body(i);
-            let b = if b.kind == 0 { Body::ZERO } else { self.checked_body(b) };
+            let b = if b.kind == 0 { Body::ZERO } else { self.with_fine_velocity(b) };
             head_and_bodies(self.planes::<u8>().1.bodies).1[i] = b;
         }
         let (_, p) = self.planes::<u8>();
@@ -231,8 +231,9 @@ impl World {
         table[..self.head.masses as usize].iter().fold(self.head.desc.mass, |a, &m| a.max(m))
     }
 
-    /// `body` with its velocity in fine units (M13: as the uniform wind).
-    fn checked_body(&self, mut body: Body) -> Body {
+    /// `body` with its velocity in fine units (M13: converted as the uniform
+    /// wind is, once, since a world's unit never changes).
+    fn with_fine_velocity(&self, mut body: Body) -> Body {
         let scale = unit_scale(self.unit());
         body.fine = body.velocity.map(|u| to_fine(u, scale));
         body

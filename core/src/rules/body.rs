@@ -121,10 +121,9 @@ impl Body {
     /// A body of `shape`, velocity `u` and restitution `e`, checked for a
     /// world of `dim` dimensions.
     pub(crate) fn new(shape: Shape, u: [f32; 3], e: f32, dim: usize) -> Result<Body, Error> {
-        shape.check(dim)?;
+        let mut body = Body { restitution: e, ..Body::ZERO };
+        body.set(shape, u, dim)?;
         restitution(e)?;
-        let mut body = Body { restitution: e, ..Body::default() };
-        body.set(shape.in_dim(dim), u, dim)?;
         Ok(body)
     }
 
