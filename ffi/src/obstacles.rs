@@ -51,15 +51,7 @@ impl mpca_shape {
     /// refused here, the geometry by the core.
     pub(crate) fn to_core(self) -> Result<Shape, mpca_status> {
         check_size::<mpca_shape>(self.struct_size)?;
-        let (a, b, radius) = (self.a, self.b, self.radius);
-        Ok(match self.kind {
-            0 => Shape::HalfSpace { point: a, normal: b },
-            1 => Shape::Box { min: a, max: b },
-            2 => Shape::Disc { centre: [a[0], a[1]], radius },
-            3 => Shape::Sphere { centre: a, radius },
-            4 => Shape::Capsule { a, b, radius },
-            _ => return Err(mpca_status::BadEnum),
-        })
+        Shape::from_parts(self.kind, self.a, self.b, self.radius).ok_or(mpca_status::BadEnum)
     }
 }
 

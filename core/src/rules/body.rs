@@ -74,7 +74,7 @@ pub(crate) fn body_surface_at(table: &[BodySurface], cell: u32) -> Option<(usize
 }
 
 /// A slot of the body table. `kind` 0 is a free slot; otherwise the shape
-/// is `kind`, `a`, `b` and `radius` ([`Body::shape`]).
+/// is `kind - 1`, `a`, `b` and `radius` ([`Shape::from_parts`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 #[repr(C)]
 pub(crate) struct Body {
@@ -84,8 +84,8 @@ pub(crate) struct Body {
     pub b: [f32; 3],
     pub radius: f32,
     pub velocity: [f32; 3],
-    /// The velocity in fine units (M1c), converted where the step and the
-    /// push-outs read it: at every redraw and at the start of every step.
+    /// The velocity in fine units (M1c), which the step and the push-outs
+    /// read: converted when the body is set or loaded.
     pub fine: [i32; 3],
     pub spare: u32,
     pub current: Tally,
@@ -139,13 +139,9 @@ impl Body {
         if u[0] * u[0] + u[1] * u[1] + u[2] * u[2] > 1.0 {
             return Err(Error::SpeedRange);
         }
-        let (kind, a, b, radius) = match shape.in_dim(dim) {
-            Shape::HalfSpace { point, normal } => (1, point, normal, 0.0),
-            Shape::Box { min, max } => (2, min, max, 0.0),
-            Shape::Disc { centre, radius } => (3, [centre[0], centre[1], 0.0], [0.0; 3], radius),
-            Shape::Sphere { centre, radius } => (4, centre, [0.0; 3], radius),
-            Shape::Capsule { a, b, radius } => (5, a, b, radius),
-        };
+        // Kind 0 is a free slot: a shape's kind is stored one up.
+        let (kind, a, b, radius) = shape.in_dim(dim).parts();
+        let kind = kind + 1;
         (self.kind, self.a, self.b, self.radius, self.velocity) = (kind, a, b, radius, u);
         Ok(())
     }
@@ -153,15 +149,7 @@ impl Body {
     /// The body's shape, or `None` for a free slot or a slot no version of
     /// the library writes.
     pub(crate) fn shape(&self) -> Option<Shape> {
-        let (a, b, radius) = (self.a, self.b, self.radius);
-        Some(match self.kind {
-            1 => Shape::HalfSpace { point: a, normal: b },
-            2 => Shape::Box { min: a, max: b },
-            3 => Shape::Disc { centre: [a[0], a[1]], radius },
-            4 => Shape::Sphere { centre: a, radius },
-            5 => Shape::Capsule { a, b, radius },
-            _ => return None,
-        })
+        Shape::from_parts(self.kind.checked_sub(1)?, self.a, self.b, self.radius)
     }
 }
 

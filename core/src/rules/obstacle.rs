@@ -127,6 +127,33 @@ pub(crate) fn surface_at(table: &[Surface], cell: u32) -> Option<&Surface> {
 }
 
 impl Shape {
+    /// The shape from four values, as C's `mpca_shape` and an image's body
+    /// table (M12, M13) hold it: `kind` 0 a half-space (`a` a point, `b`
+    /// the normal), 1 a box (`a`, `b` its corners), 2 a disc (`a`'s x and
+    /// y its centre), 3 a sphere (`a` its centre), 4 a capsule (`a`, `b`
+    /// its ends); `radius` for the last three. `None` for another kind.
+    pub fn from_parts(kind: u32, a: [f32; 3], b: [f32; 3], radius: f32) -> Option<Shape> {
+        Some(match kind {
+            0 => Shape::HalfSpace { point: a, normal: b },
+            1 => Shape::Box { min: a, max: b },
+            2 => Shape::Disc { centre: [a[0], a[1]], radius },
+            3 => Shape::Sphere { centre: a, radius },
+            4 => Shape::Capsule { a, b, radius },
+            _ => return None,
+        })
+    }
+
+    /// The four values [`Shape::from_parts`] takes back.
+    pub fn parts(&self) -> (u32, [f32; 3], [f32; 3], f32) {
+        match *self {
+            Shape::HalfSpace { point, normal } => (0, point, normal, 0.0),
+            Shape::Box { min, max } => (1, min, max, 0.0),
+            Shape::Disc { centre, radius } => (2, [centre[0], centre[1], 0.0], [0.0; 3], radius),
+            Shape::Sphere { centre, radius } => (3, centre, [0.0; 3], radius),
+            Shape::Capsule { a, b, radius } => (4, a, b, radius),
+        }
+    }
+
     /// The shape as a world of `dim` dimensions uses it: in 2D a
     /// half-space's normal loses its z, as [`World::add_obstacle`](crate::World::add_obstacle)'s does
     /// (every other shape reads only the axes the world has).
