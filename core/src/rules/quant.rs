@@ -69,28 +69,10 @@ pub(crate) trait Quant: Copy + Default + Send + crate::storage::plain::Plain + '
     /// Fine units to a unit speed (M1c's `W`, `SCALE 2^FINE`).
     const UNIT: i32;
 
-    /// Stochastic rounding of `x`, a working component in fine units
-    /// within a unit speed (every stage that changes a velocity ends with
-    /// the clamp, M5.5), with the low [`Quant::FINE`] of 16 random bits `r`
-    /// (M1c): `(x + r) >> FINE`. Its mean is `x / 2^FINE` exactly, and a
-    /// whole number of quanta comes back as it is.
+    /// [`Width::stochastic`] for this type's width.
     #[inline(always)]
     fn stochastic(x: i32, r: u32) -> i32 {
-        debug_assert!((-Self::UNIT..=Self::UNIT).contains(&x));
-        (x + (r & ((1 << Self::FINE) - 1)) as i32) >> Self::FINE
-    }
-
-    /// M1: every component of `x` (in fine units) rounded stochastically,
-    /// 16 bits of the stream a component: 32 bits in 2D, a whole 64-bit
-    /// output in 3D.
-    #[inline(always)]
-    fn round<const D: usize>(x: [i32; 3], rng: &mut Stream) -> [i32; D] {
-        let r = if D == 2 { u64::from(rng.bits(32)) } else { rng.next_u64() };
-        let mut out = [0; D];
-        for k in 0..D {
-            out[k] = Self::stochastic(x[k], (r >> (16 * k)) as u32);
-        }
-        out
+        Width::of::<Self>().stochastic(x, r)
     }
 
     /// M5.3: the largest 16 random bits `r` that say "move" for a stored
@@ -99,6 +81,78 @@ pub(crate) trait Quant: Copy + Default + Send + crate::storage::plain::Plain + '
     /// the drift rule's probability. `table` is [`move_table_8`]'s table for
     /// `drift`, which 8-bit storage reads.
     fn move_limit(table: &[u16; 256], drift: Drift, q: i32) -> u32;
+}
+
+/// A stored velocity width as values rather than a type (M1, M1c): what
+/// the step's pipeline with every part reads from the step's data, so that
+/// one copy of it serves both widths. [`Width::of`] a type folds to
+/// constants wherever the type is known at compile time.
+#[derive(Clone, Copy)]
+pub(crate) struct Width {
+    /// [`Quant::FINE`].
+    pub fine: u32,
+    /// [`Quant::UNIT`].
+    pub unit: i32,
+    /// `2^fine - 1`: the random bits of a rounding.
+    low: u32,
+    /// 16-bit storage; read through [`Width::wide`].
+    wide: bool,
+}
+
+impl Width {
+    /// The width of `Q`.
+    #[inline(always)]
+    pub(crate) const fn of<Q: Quant>() -> Width {
+        Width { fine: Q::FINE, unit: Q::UNIT, low: (1 << Q::FINE) - 1, wide: core::mem::size_of::<Q>() > 1 }
+    }
+
+    /// The width of a world of `quantization` (read by the pipeline with
+    /// every part, which `small-step` instantiates per width instead).
+    #[cfg(not(feature = "small-step"))]
+    pub(crate) fn of_quantization(quantization: crate::api::desc::Quantization) -> Width {
+        with_quant!(quantization, Q => Width::of::<Q>())
+    }
+
+    /// 16-bit storage: never in a build without the feature `q16`, where
+    /// this folds to false.
+    #[inline(always)]
+    pub(crate) fn wide(self) -> bool {
+        cfg!(feature = "q16") && self.wide
+    }
+
+    /// Stochastic rounding of `x`, a working component in fine units
+    /// within a unit speed (every stage that changes a velocity ends with
+    /// the clamp, M5.5), with the low [`Quant::FINE`] of 16 random bits `r`
+    /// (M1c): `(x + r) >> FINE`. Its mean is `x / 2^FINE` exactly, and a
+    /// whole number of quanta comes back as it is.
+    #[inline(always)]
+    pub(crate) fn stochastic(self, x: i32, r: u32) -> i32 {
+        debug_assert!((-self.unit..=self.unit).contains(&x));
+        (x + (r & self.low) as i32) >> self.fine
+    }
+
+    /// M1: every component of `x` (in fine units) rounded stochastically,
+    /// 16 bits of the stream a component: 32 bits in 2D, a whole 64-bit
+    /// output in 3D.
+    #[inline(always)]
+    pub(crate) fn round<const D: usize>(self, x: [i32; 3], rng: &mut Stream) -> [i32; D] {
+        let r = if D == 2 { u64::from(rng.bits(32)) } else { rng.next_u64() };
+        let mut out = [0; D];
+        for k in 0..D {
+            out[k] = self.stochastic(x[k], (r >> (16 * k)) as u32);
+        }
+        out
+    }
+
+    /// [`Quant::move_limit`] of this width's type.
+    #[inline(always)]
+    pub(crate) fn move_limit(self, table: &[u16; 256], drift: Drift, q: i32) -> u32 {
+        #[cfg(feature = "q16")]
+        if self.wide() {
+            return i16::move_limit(table, drift, q);
+        }
+        i8::move_limit(table, drift, q)
+    }
 }
 
 /// `round(p 2^16)` for `p = a/S` (paper) and `p = 2a/(S + a)`

@@ -3,7 +3,6 @@
 //! in the table of every block state's optimal assignments.
 
 use crate::rules::assign::{assign_moves, optimal_moves_2d, pick_move, Method, MoveProblem, PLACE_2D};
-use crate::rules::quant::Quant;
 use crate::rules::rng::Stream;
 use crate::step::block::cells_of;
 use crate::step::block::Kernel;
@@ -137,7 +136,7 @@ fn solve_block_2d(method: Method, cells: (u8, u8), want: u8, speeds: &[u32; 4], 
     solve_block::<2, 4>(method, cells, u32::from(want), |c| speeds[c], rng, displaced)
 }
 
-impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
+impl<const D: usize, const CELLS: usize> Kernel<'_, D, CELLS> {
     /// M5.6: where each particle goes, `targets >> 4c & 7` for the particle
     /// in cell `c`, counting those not placed in their desired cell. `want`
     /// holds the axes each wants to cross, `D` bits a cell (a desired cell

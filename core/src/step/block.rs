@@ -1,7 +1,8 @@
 //! What the block pipeline works with: the data every block of a step
 //! reads, the planes the step writes, the pipeline's parameters (the parts
-//! it has code for), where a block lies and what its particles carry, and
-//! one block's particles as the stages of M5 see them.
+//! it has code for, the velocity width it reads), where a block lies and
+//! what its particles carry, and one block's particles as the stages of M5
+//! see them.
 
 use crate::api::desc::Description;
 use crate::rules::assign::{bits, Bits};
@@ -9,10 +10,11 @@ use crate::rules::class::Class;
 use crate::rules::faces::Coords;
 use crate::rules::force::{Flow, ForceTerms};
 use crate::rules::obstacle::Surface;
-use crate::rules::quant::Quant;
+use crate::rules::quant::{Quant, Width};
 use crate::rules::rng::StepKey;
 use crate::step::partition::{BlockRow, Partition};
 use crate::storage::cells::Cells;
+use crate::storage::layout::{groups, view};
 use crate::storage::world::Counters;
 
 /// The description as a step's blocks read it: with `small-step` where it
@@ -37,15 +39,16 @@ impl Shared<'_> {
 }
 
 /// The block pipeline (`step/kernel.rs`), specialised once per step (M9)
-/// on the stored velocity type `Q` and the dimension `D` (with
-/// `CELLS = 2^D` cells a block). Summed forces, obstacles, per-particle masses and lifetimes are
-/// per-step switches: each costs a predictable branch per block or per
-/// particle where the pipeline has code for [`Every`] part, and sends every
-/// block there when it is on ([`Shared::plain`]), so the plain
-/// instantiations never test them.
-pub(crate) struct Kernel<'a, Q, const D: usize, const CELLS: usize> {
+/// on the dimension `D` (with `CELLS = 2^D` cells a block); its methods
+/// take the velocity width ([`Widths`]) as a parameter. Summed forces,
+/// obstacles, per-particle masses and lifetimes are per-step switches:
+/// each costs a predictable branch per block or per particle where the
+/// pipeline has code for [`Every`] part, and sends every block there when
+/// it is on ([`Shared::plain`]), so the plain instantiations never test
+/// them.
+pub(crate) struct Kernel<'a, const D: usize, const CELLS: usize> {
     pub shared: &'a Shared<'a>,
-    pub planes: Writable<'a, Q, D>,
+    pub planes: Writable<'a, D>,
     pub counters: Counters,
 }
 
@@ -80,6 +83,96 @@ impl Parts for Plain {
 impl Parts for Bare {
     const ALL: bool = false;
     const CONTACTS: bool = false;
+}
+
+/// The stored velocity width (M1) an instantiation of the pipeline has
+/// code for: a stored type's ([`Typed`]), which folds at compile time, or
+/// the step's, read at run time ([`AnyWidth`]).
+pub(crate) trait Widths {
+    /// The width as values.
+    fn width(sh: &Shared<'_>) -> Width;
+    /// The block of occupancy `occ` whose block rows lie in `row`, its
+    /// cells at x `xs` ([`Block::load`]).
+    fn load<const D: usize, const CELLS: usize>(velocity: &Velocity<'_, D>, sh: &Shared<'_>, row: &BlockRow, xs: [usize; 2], occ: u8) -> Block<D, CELLS>;
+    /// Makes `q` (in quanta, within the stored range) the stored velocity
+    /// of cell `at`. By reference: the components are read in place (a
+    /// copy first takes more flash in the firmware).
+    fn store<const D: usize>(velocity: &Velocity<'_, D>, sh: &Shared<'_>, at: usize, q: &[i32; D]);
+}
+
+/// A stored velocity type, with its plane among the step's.
+pub(crate) trait Typed: Quant {
+    /// The velocity plane of a world of this type.
+    fn plane<'a, const D: usize>(velocity: &Velocity<'a, D>) -> Cells<'a, [Self; D]>;
+}
+
+impl Typed for i8 {
+    #[inline(always)]
+    fn plane<'a, const D: usize>(velocity: &Velocity<'a, D>) -> Cells<'a, [i8; D]> {
+        velocity.narrow
+    }
+}
+
+#[cfg(feature = "q16")]
+impl Typed for i16 {
+    #[inline(always)]
+    fn plane<'a, const D: usize>(velocity: &Velocity<'a, D>) -> Cells<'a, [i16; D]> {
+        velocity.wide
+    }
+}
+
+impl<Q: Typed> Widths for Q {
+    #[inline(always)]
+    fn width(_: &Shared<'_>) -> Width {
+        Width::of::<Q>()
+    }
+
+    #[inline(always)]
+    fn load<const D: usize, const CELLS: usize>(velocity: &Velocity<'_, D>, _: &Shared<'_>, row: &BlockRow, xs: [usize; 2], occ: u8) -> Block<D, CELLS> {
+        Block::load(Q::plane(velocity), row, xs, occ)
+    }
+
+    #[inline(always)]
+    fn store<const D: usize>(velocity: &Velocity<'_, D>, _: &Shared<'_>, at: usize, q: &[i32; D]) {
+        // Component by component: an array's `map` is a call at opt-level z.
+        let mut v = [Q::from_int(0); D];
+        for k in 0..D {
+            v[k] = Q::from_int(q[k]);
+        }
+        Q::plane(velocity).set(at, v);
+    }
+}
+
+/// The width of the step's world, read from its shared data
+/// ([`Shared::width`]): the pipeline with every part, one copy of which
+/// serves both widths (not with `small-step`: `Sink::every`).
+#[cfg(not(feature = "small-step"))]
+pub(crate) struct AnyWidth;
+
+#[cfg(not(feature = "small-step"))]
+impl Widths for AnyWidth {
+    #[inline(always)]
+    fn width(sh: &Shared<'_>) -> Width {
+        sh.width
+    }
+
+    #[inline(always)]
+    fn load<const D: usize, const CELLS: usize>(velocity: &Velocity<'_, D>, sh: &Shared<'_>, row: &BlockRow, xs: [usize; 2], occ: u8) -> Block<D, CELLS> {
+        #[cfg(feature = "q16")]
+        if sh.width.wide() {
+            return <i16 as Widths>::load(velocity, sh, row, xs, occ);
+        }
+        <i8 as Widths>::load(velocity, sh, row, xs, occ)
+    }
+
+    #[inline(always)]
+    fn store<const D: usize>(velocity: &Velocity<'_, D>, sh: &Shared<'_>, at: usize, q: &[i32; D]) {
+        #[cfg(feature = "q16")]
+        if sh.width.wide() {
+            return <i16 as Widths>::store(velocity, sh, at, q);
+        }
+        <i8 as Widths>::store(velocity, sh, at, q);
+    }
 }
 
 /// Where a block lies (M3, M4): its cells in the planes, and the cells
@@ -173,6 +266,11 @@ pub(crate) struct Shared<'a> {
     pub desc: StepDescription<'a>,
     pub n: [usize; 3],
     pub part: Partition,
+    /// The width of the world's stored velocities, which the pipeline with
+    /// every part reads ([`AnyWidth`]); not with `small-step`, whose
+    /// pipeline takes the width as a type.
+    #[cfg(not(feature = "small-step"))]
+    pub width: Width,
     pub key: StepKey,
     pub obstacle: &'a [u64],
     pub surface: &'a [Surface],
@@ -238,17 +336,40 @@ pub(crate) struct Moving<'a> {
     pub tally: Cells<'a, crate::rules::body::CellTally>,
 }
 
-/// The planes a step writes; `velocity` holds a cell's `D` components
-/// together. Copies go to the tasks of a parallel step, which write
-/// disjoint elements ([`Cells`]).
+/// The planes a step writes. Copies go to the tasks of a parallel step,
+/// which write disjoint elements ([`Cells`]).
 #[derive(Clone, Copy)]
-pub(crate) struct Writable<'a, Q, const D: usize> {
+pub(crate) struct Writable<'a, const D: usize> {
     pub occupancy: Cells<'a, u64>,
     pub rows: Cells<'a, u8>,
     pub words: Cells<'a, u64>,
-    pub velocity: Cells<'a, [Q; D]>,
+    pub velocity: Velocity<'a, D>,
     pub mass_index: Cells<'a, u8>,
     pub life: Cells<'a, u16>,
+}
+
+/// The velocity plane, a cell's `D` components together, as the type the
+/// world stores ([`Typed::plane`]): the plane of the other width is empty.
+#[derive(Clone, Copy)]
+pub(crate) struct Velocity<'a, const D: usize> {
+    pub narrow: Cells<'a, [i8; D]>,
+    #[cfg(feature = "q16")]
+    pub wide: Cells<'a, [i16; D]>,
+}
+
+impl<'a, const D: usize> Velocity<'a, D> {
+    /// The plane `bytes` of velocities of `width`.
+    pub(crate) fn new(bytes: &'a mut [u8], width: Width) -> Self {
+        if width.wide() {
+            #[cfg(feature = "q16")]
+            return Velocity { narrow: Cells::new(&mut []), wide: Cells::new(groups(view(bytes))) };
+        }
+        Velocity {
+            narrow: Cells::new(groups(view(bytes))),
+            #[cfg(feature = "q16")]
+            wide: Cells::new(&mut []),
+        }
+    }
 }
 
 /// The identity planes a step writes (M6b, `step/identity.rs`), to

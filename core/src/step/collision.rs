@@ -5,11 +5,10 @@
 use crate::api::desc::Collisions;
 use crate::rules::collision::{collide_limited, collide_pair, difference, energy_neutral, shares, turned, HALVES};
 use crate::rules::fixed::{csqrt, sq};
-use crate::rules::quant::Quant;
 use crate::rules::rng::Stream;
 use crate::rules::class::Class;
 use crate::step::clamp::clamp_counted;
-use crate::step::block::Kernel;
+use crate::step::block::{Kernel, Widths};
 
 /// M5.2b's limit on a squared speed in fine units (M1c): a unit speed
 /// `unit` less `sqrt(D)` quanta (`2^fine` fine units each) rounded up,
@@ -20,7 +19,7 @@ fn speed_limit2<const D: usize>(unit: i32, fine: u32) -> u64 {
     limit * limit
 }
 
-impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
+impl<const D: usize, const CELLS: usize> Kernel<'_, D, CELLS> {
     /// M5.2 on two particles of classes `(ca, cc)` with velocities `va`,
     /// `vc` in fine units: eqs. 7-8 with `R` uniform (or M5.2b), M1b when
     /// on, then the clamp of both; counts the collision. `equal` says
@@ -29,11 +28,12 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
     /// (eqs. 7-8 give both the centre-of-mass velocity, which is theirs),
     /// so a pair at rest draws nothing for it.
     #[inline(always)]
-    pub(crate) fn collide_two(&mut self, va: [i32; 3], vc: [i32; 3], (ca, cc): (Class, Class), equal: bool, rng: &mut Stream) -> Option<([i32; 3], [i32; 3])> {
+    pub(crate) fn collide_two<W: Widths>(&mut self, va: [i32; 3], vc: [i32; 3], (ca, cc): (Class, Class), equal: bool, rng: &mut Stream) -> Option<([i32; 3], [i32; 3])> {
         self.counters.collisions += 1;
+        let w = W::width(self.shared);
         // Component by component: an array comparison is a `memcmp` call
         // on small cores.
-        if (va[0] ^ vc[0]) | (va[1] ^ vc[1]) | (va[2] ^ vc[2]) == 0 && sq::<D>(va) <= (Q::UNIT as u64) * (Q::UNIT as u64) {
+        if (va[0] ^ vc[0]) | (va[1] ^ vc[1]) | (va[2] ^ vc[2]) == 0 && sq::<D>(va) <= (w.unit as u64) * (w.unit as u64) {
             return None;
         }
         let masses = (!equal).then_some((ca.relative, cc.relative));
@@ -43,13 +43,13 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
             Collisions::Paper => collide_pair::<D>(va, vc, s, e, turned::<D>(difference::<D>(va, vc), rng), masses),
             // Below the limit by sqrt(D) quanta, so that rounding (less than a
             // quantum per component) cannot store a speed above 1 either.
-            Collisions::SpeedLimited => collide_limited(va, vc, s, e, speed_limit2::<D>(Q::UNIT, Q::FINE), masses, rng, D),
+            Collisions::SpeedLimited => collide_limited(va, vc, s, e, speed_limit2::<D>(w.unit, w.fine), masses, rng, D),
         };
         if self.shared.desc.has_energy_neutral() {
-            (xa, xc) = energy_neutral(xa, xc, s, Q::FINE, masses);
+            (xa, xc) = energy_neutral(xa, xc, s, w.fine, masses);
         }
-        clamp_counted::<D>(&mut xa, Q::UNIT, &ca, &mut self.counters);
-        clamp_counted::<D>(&mut xc, Q::UNIT, &cc, &mut self.counters);
+        clamp_counted::<D>(&mut xa, w.unit, &ca, &mut self.counters);
+        clamp_counted::<D>(&mut xc, w.unit, &cc, &mut self.counters);
         Some((xa, xc))
     }
 }

@@ -2,11 +2,10 @@
 //! stages before the collision, which draw nothing.
 
 use crate::rules::fixed::{fit, mulq, sat};
-use crate::rules::quant::Quant;
 use crate::rules::class::Class;
 use crate::step::block::{cells_of, Stored};
 use crate::step::clamp::clamp_counted;
-use crate::step::block::{Carried, Kernel, Parts, Site};
+use crate::step::block::{Carried, Kernel, Parts, Site, Widths};
 use crate::step::rounding::Changes;
 
 /// M5.1's sum `x + dv` of a velocity within a unit speed and a push (fine
@@ -24,7 +23,7 @@ pub(crate) fn pushed_small(x: [i32; 3], dv: [i32; 3]) -> [i32; 3] {
     [x[0] + dv[0], x[1] + dv[1], x[2] + dv[2]]
 }
 
-impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
+impl<const D: usize, const CELLS: usize> Kernel<'_, D, CELLS> {
     /// Whether M5.1 or M5.1b may change a velocity of the block.
     #[inline(always)]
     pub(crate) fn pushes<P: Parts>(&self) -> bool {
@@ -37,15 +36,16 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
     /// nothing is no step 1: a zero-valued part gives the same world as a
     /// world without it (M9).
     #[inline(always)]
-    pub(crate) fn force<P: Parts>(&mut self, site: &Site<'_>, b: &impl Stored<D>, changes: &mut Changes<CELLS>, carried: &Carried<CELLS>) {
+    pub(crate) fn force<W: Widths, P: Parts>(&mut self, site: &Site<'_>, b: &impl Stored<D>, changes: &mut Changes<CELLS>, carried: &Carried<CELLS>) {
         let sh = self.shared;
+        let fine = W::width(sh).fine;
         // A plain block's uniform force, small enough to add in 32 bits;
         // where the block has every part, the loop below serves it too (one
         // loop: less code).
         let small = if P::ALL { None } else { sh.lean_push };
         if let Some(dv) = small {
             for c in cells_of(b.occ()) {
-                self.push(changes, c, pushed_small(b.fine(c, Q::FINE), dv), &carried.class(sh, c));
+                self.push::<W>(changes, c, pushed_small(b.fine(c, fine), dv), &carried.class(sh, c));
             }
         } else if P::ALL {
             for c in cells_of(b.occ()) {
@@ -60,7 +60,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
                 if dv[0] | dv[1] | dv[2] != 0 {
                     // The stored velocity (nothing changed it yet), read
                     // through the one copy of that read `small-step` has.
-                    self.push(changes, c, pushed(changes.velocity(b, c, Q::FINE), dv), &class);
+                    self.push::<W>(changes, c, pushed(changes.velocity(b, c, fine), dv), &class);
                 }
             }
         }
@@ -69,8 +69,8 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
     /// M5.1 for the particle in cell `c` of class `class`, whose velocity
     /// with its push is `x`: the clamp (M5.5).
     #[inline(always)]
-    fn push(&mut self, changes: &mut Changes<CELLS>, c: usize, mut x: [i32; 3], class: &Class) {
-        clamp_counted::<D>(&mut x, Q::UNIT, class, &mut self.counters);
+    fn push<W: Widths>(&mut self, changes: &mut Changes<CELLS>, c: usize, mut x: [i32; 3], class: &Class) {
+        clamp_counted::<D>(&mut x, W::width(self.shared).unit, class, &mut self.counters);
         changes.set(c, x);
     }
 
@@ -79,18 +79,18 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
     /// the weighted mean `C v + (1 - C) u` with `C` in Q16 (M1c), then the
     /// clamp.
     #[inline(always)]
-    pub(crate) fn drag(&mut self, site: &Site<'_>, b: &impl Stored<D>, changes: &mut Changes<CELLS>, carried: &Carried<CELLS>) {
+    pub(crate) fn drag<W: Widths>(&mut self, site: &Site<'_>, b: &impl Stored<D>, changes: &mut Changes<CELLS>, carried: &Carried<CELLS>) {
         let sh = self.shared;
         let drag = if cfg!(feature = "fields") { sh.drag.as_ref() } else { None };
         let Some(flow) = drag else { return };
         let keep = flow.keep;
         for c in cells_of(b.occ()) {
             let u = flow.at(sh.part.cell_coords(site.row, [site.xs[c & 1], 0, 0], c), site.cell(c));
-            let mut x = changes.velocity(b, c, Q::FINE);
+            let mut x = changes.velocity(b, c, W::width(sh).fine);
             for k in 0..D {
                 x[k] = sat(i64::from(mulq(x[k], keep, 16)) + i64::from(mulq(u[k], (1 << 16) - keep, 16)));
             }
-            self.push(changes, c, x, &carried.class(sh, c));
+            self.push::<W>(changes, c, x, &carried.class(sh, c));
         }
     }
 }

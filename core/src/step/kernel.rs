@@ -24,9 +24,15 @@
 //! - the block's representation ([`Plane`]): per-cell arrays ([`Block`]),
 //!   or, for the plain 2D block of an 8-bit world, one word of byte lanes
 //!   ([`Lanes`]), whose rarer stages run out of line;
+//! - the stored velocity width ([`Widths`]): the plain instantiations take
+//!   the world's as a type, which folds at compile time; the one with
+//!   [`Every`] part reads it from the step's data ([`AnyWidth`]), so that
+//!   one copy serves both widths: the width shows only in its loads and
+//!   writes of the velocity plane, the fine units and the clamp's limit
+//!   (M1c, M5.5), the rounding (M1) and the move limits (M5.3);
 //! - the firmware's size-before-speed choices (feature `small-step`):
-//!   every block takes [`Every`] with cells in loops, and the helpers that
-//!   every stage calls stay out of line.
+//!   every block takes [`Every`] with cells in loops, at the world's width
+//!   as a type, and the helpers that every stage calls stay out of line.
 //!
 //! The stages live in files named after their rules: the force and drag
 //! (M5.1, M5.1b, `force.rs`), the collision (M5.2, `collision.rs`), the
@@ -56,67 +62,80 @@
 use crate::api::desc::Identity;
 use crate::rules::collision::pick_pair;
 use crate::rules::faces::{resolve, Beyond};
-use crate::rules::quant::Quant;
+use core::marker::PhantomData;
+
 use crate::rules::rng::Stream;
 use crate::step::assign::{stored_speed2, FIELDS, IDENTITY};
-use crate::step::block::{cells_of, each_occupied, Bare, Block, Carried, Every, Kernel, Parts, Plain, Site, Stored};
+#[cfg(not(feature = "small-step"))]
+use crate::step::block::AnyWidth;
+use crate::step::block::{cells_of, each_occupied, Bare, Block, Carried, Every, Kernel, Parts, Plain, Shared, Site, Stored, Typed, Velocity, Widths};
 #[cfg(feature = "identity")]
 use crate::step::identity::carry;
 use crate::step::contacts::contacts;
 use crate::step::lanes::Lanes;
 use crate::step::partition::{cells_at, BlockRow, BlockSink, Index};
 use crate::step::rounding::{round_apart, Changes};
-use crate::storage::cells::Cells;
 use crate::storage::layout::{mark, put_bit};
 
-/// A representation of a block's velocities ([`Stored`]) with its reads
-/// and writes of the velocity plane.
-pub(crate) trait Plane<Q, const D: usize>: Stored<D> {
+/// A representation of a block's velocities ([`Stored`]) with its writes
+/// of the velocity plane of width `W`.
+pub(crate) trait Plane<W, const D: usize>: Stored<D> {
     /// The stages that most blocks of a step skip (the force and
     /// collision, the assignment and write back) run out of line: the
     /// sweep's loop keeps its registers.
     const APART: bool;
-    /// Cell `c`'s stored velocity as the plane holds it.
-    fn to_plane(&self, c: usize) -> [Q; D];
+    /// Writes cell `c`'s stored velocity to cell `at` of the plane.
+    fn write(&self, velocity: &Velocity<'_, D>, sh: &Shared<'_>, c: usize, at: usize);
     /// Writes the velocities that changed (`dirty`) back to their own
     /// cells, where no particle moved.
-    fn write_in_place(&self, velocity: Cells<'_, [Q; D]>, site: &Site<'_>);
+    fn write_in_place(&self, velocity: &Velocity<'_, D>, sh: &Shared<'_>, site: &Site<'_>);
 }
 
-impl<Q: Quant, const D: usize, const CELLS: usize> Plane<Q, D> for Block<D, CELLS> {
+impl<W: Widths, const D: usize, const CELLS: usize> Plane<W, D> for Block<D, CELLS> {
     const APART: bool = false;
 
     #[inline(always)]
-    fn to_plane(&self, c: usize) -> [Q; D] {
-        // Component by component: an array's `map` is a call at opt-level z.
-        let mut q = [Q::from_int(0); D];
-        for k in 0..D {
-            q[k] = Q::from_int(self.v[c][k]);
-        }
-        q
+    fn write(&self, velocity: &Velocity<'_, D>, sh: &Shared<'_>, c: usize, at: usize) {
+        W::store(velocity, sh, at, &self.v[c]);
     }
 
     #[inline(always)]
-    fn write_in_place(&self, velocity: Cells<'_, [Q; D]>, site: &Site<'_>) {
+    fn write_in_place(&self, velocity: &Velocity<'_, D>, sh: &Shared<'_>, site: &Site<'_>) {
         for c in cells_of(self.dirty) {
-            velocity.set(site.cell(c), self.to_plane(c));
+            W::store(velocity, sh, site.cell(c), &self.v[c]);
         }
     }
 }
 
-impl<Q: Quant, const D: usize> Plane<Q, D> for Lanes {
+impl<Q: Typed, const D: usize> Plane<Q, D> for Lanes {
     const APART: bool = true;
 
     #[inline(always)]
-    fn to_plane(&self, c: usize) -> [Q; D] {
-        self.to_plane::<Q, D>(c)
+    fn write(&self, velocity: &Velocity<'_, D>, _: &Shared<'_>, c: usize, at: usize) {
+        Q::plane(velocity).set(at, self.to_plane::<Q, D>(c));
     }
 
     #[inline(always)]
-    fn write_in_place(&self, velocity: Cells<'_, [Q; D]>, site: &Site<'_>) {
+    fn write_in_place(&self, velocity: &Velocity<'_, D>, _: &Shared<'_>, site: &Site<'_>) {
         // SAFETY: a lanes block is loaded only where the row plan's bound
         // holds for its x0 (`visit`).
-        unsafe { self.write_rows(velocity, site.row, site.xs[0]) }
+        unsafe { self.write_rows(Q::plane(velocity), site.row, site.xs[0]) }
+    }
+}
+
+/// What the sweep hands the blocks of a world of stored type `Q` to: the
+/// pipeline, whose plain instantiations take `Q`'s width at compile time,
+/// and whose one with every part reads the step's ([`AnyWidth`]).
+pub(crate) struct Sink<'a, Q, const D: usize, const CELLS: usize> {
+    pub kernel: Kernel<'a, D, CELLS>,
+    stored: PhantomData<Q>,
+}
+
+impl<'a, Q, const D: usize, const CELLS: usize> Sink<'a, Q, D, CELLS> {
+    /// The sink of a world of `Q` for `kernel`.
+    #[inline(always)]
+    pub(crate) fn new(kernel: Kernel<'a, D, CELLS>) -> Self {
+        Sink { kernel, stored: PhantomData }
     }
 }
 
@@ -153,7 +172,7 @@ fn read_block<const CELLS: usize>(plane: &[u64], row: &BlockRow, xs: [usize; 2])
     bits
 }
 
-impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
+impl<const D: usize, const CELLS: usize> Kernel<'_, D, CELLS> {
     /// Every cell of the block.
     pub(crate) const EVERY_CELL: u8 = {
         assert!(CELLS == 1 << D && (D == 2 || D == 3));
@@ -164,7 +183,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
     /// velocities `b`, drawing from the stream of block `index` (M8): the
     /// one place where the stages and their draws are put in order.
     #[inline(always)]
-    fn local_map<P: Parts, R: Plane<Q, D>>(&mut self, site: &Site<'_>, index: u64, mut b: R) {
+    fn local_map<W: Widths, P: Parts, R: Plane<W, D>>(&mut self, site: &Site<'_>, index: u64, mut b: R) {
         let carried = self.carried::<P>(site, b.occ());
         let mut rng = self.shared.key.stream(index);
         // M5.2's pair, the block's first draw: nothing before the collision
@@ -175,14 +194,14 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
         // tests would take more flash than they save.
         if cfg!(feature = "small-step") || pair.is_some() || self.pushes::<P>() {
             if R::APART {
-                b = self.change_apart::<P, R>(site.row, site.xs[0], b, pair, &mut rng);
+                b = self.change_apart::<W, P, R>(site.row, site.xs[0], b, pair, &mut rng);
             } else {
-                self.change::<P, R>(site, &mut b, &carried, pair, &mut rng);
+                self.change::<W, P, R>(site, &mut b, &carried, pair, &mut rng);
             }
         }
         // M5.3 desired move, M5.4 reflection: the axes each particle wants
         // to cross, `D` bits a cell.
-        let want = self.desire::<P, R>(site, &mut b, &carried, &mut rng);
+        let want = self.desire::<W, P, R>(site, &mut b, &carried, &mut rng);
         self.counters.processed += 1;
         // Plain blocks only: for the others `finish` serves this case too
         // (less code; with `small-step`, less flash).
@@ -190,15 +209,15 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
             // M5.6 leaves every particle in place without a draw, and M5.7
             // has no refused particle: only changed velocities to write.
             if b.dirty() != 0 {
-                b.write_in_place(self.planes.velocity, site);
+                b.write_in_place(&self.planes.velocity, self.shared, site);
             }
             return;
         }
         // M5.6 move, M5.7 contacts, and the block written back.
         if R::APART {
-            self.finish_apart::<P, R>(site.row, site.xs[0], b, want, &mut rng);
+            self.finish_apart::<W, P, R>(site.row, site.xs[0], b, want, &mut rng);
         } else {
-            self.finish::<P, R>(site, &mut b, &carried, want, &mut rng);
+            self.finish::<W, P, R>(site, &mut b, &carried, want, &mut rng);
         }
     }
 
@@ -226,8 +245,9 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
     /// M5.1, M5.1b, M5.2 on the block (the collision on `pair`, when both
     /// its cells hold a particle), then M1 for what they changed.
     #[inline(always)]
-    fn change<P: Parts, R: Plane<Q, D>>(&mut self, site: &Site<'_>, b: &mut R, carried: &Carried<CELLS>, pair: Option<(usize, usize)>, rng: &mut Stream) {
+    fn change<W: Widths, P: Parts, R: Plane<W, D>>(&mut self, site: &Site<'_>, b: &mut R, carried: &Carried<CELLS>, pair: Option<(usize, usize)>, rng: &mut Stream) {
         let sh = self.shared;
+        let w = W::width(sh);
         let class = |c: usize| carried.class(sh, c);
         // A lanes block where only the collision changes anything (most
         // of a 2D gas's): its two results rounded in cell order (a < c in
@@ -237,25 +257,25 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
         // saves time elsewhere.
         if R::APART && !self.pushes::<P>() {
             let Some((a, c)) = pair else { return };
-            if let Some((xa, xc)) = self.collide_two(b.fine(a, Q::FINE), b.fine(c, Q::FINE), (class(a), class(c)), !carried.masses(), rng) {
-                b.put(a, Q::round::<D>(xa, rng));
-                b.put(c, Q::round::<D>(xc, rng));
+            if let Some((xa, xc)) = self.collide_two::<W>(b.fine(a, w.fine), b.fine(c, w.fine), (class(a), class(c)), !carried.masses(), rng) {
+                b.put(a, w.round::<D>(xa, rng));
+                b.put(c, w.round::<D>(xc, rng));
             }
             return;
         }
         let mut changes = Changes::<CELLS>::new();
-        self.force::<P>(site, b, &mut changes, carried);
+        self.force::<W, P>(site, b, &mut changes, carried);
         if P::ALL {
-            self.drag(site, b, &mut changes, carried);
+            self.drag::<W>(site, b, &mut changes, carried);
         }
         if let Some((a, c)) = pair {
-            let (va, vc) = (changes.velocity(b, a, Q::FINE), changes.velocity(b, c, Q::FINE));
-            if let Some((xa, xc)) = self.collide_two(va, vc, (class(a), class(c)), !carried.masses(), rng) {
+            let (va, vc) = (changes.velocity(b, a, w.fine), changes.velocity(b, c, w.fine));
+            if let Some((xa, xc)) = self.collide_two::<W>(va, vc, (class(a), class(c)), !carried.masses(), rng) {
                 changes.set(a, xa);
                 changes.set(c, xc);
             }
         }
-        changes.round::<Q, D>(b, rng);
+        changes.round::<W, D>(b, sh, rng);
     }
 
     /// [`Kernel::change`] out of line, for a plain block (`!P::ALL`) at
@@ -264,9 +284,9 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
     /// by value: passed by reference, each would be written to memory for
     /// every block.
     #[inline(never)]
-    fn change_apart<P: Parts, R: Plane<Q, D>>(&mut self, row: &BlockRow, x0: usize, mut b: R, pair: Option<(usize, usize)>, rng: &mut Stream) -> R {
+    fn change_apart<W: Widths, P: Parts, R: Plane<W, D>>(&mut self, row: &BlockRow, x0: usize, mut b: R, pair: Option<(usize, usize)>, rng: &mut Stream) -> R {
         debug_assert!(!P::ALL);
-        self.change::<P, R>(&Site::plain(row, x0), &mut b, &Carried::none(), pair, rng);
+        self.change::<W, P, R>(&Site::plain(row, x0), &mut b, &Carried::none(), pair, rng);
         b
     }
 
@@ -276,8 +296,9 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
     /// particle gone through an open face (M4) or at the end of its
     /// lifetime (M6), and the occupancy.
     #[inline(always)]
-    fn finish<P: Parts, R: Plane<Q, D>>(&mut self, site: &Site<'_>, b: &mut R, carried: &Carried<CELLS>, want: u32, rng: &mut Stream) {
+    fn finish<W: Widths, P: Parts, R: Plane<W, D>>(&mut self, site: &Site<'_>, b: &mut R, carried: &Carried<CELLS>, want: u32, rng: &mut Stream) {
         let sh = self.shared;
+        let w = W::width(sh);
         let occ = b.occ();
         let targets = self.assign(occ, |c| stored_speed2(b.stored(c)), site.blocked, want, rng);
         if P::CONTACTS && sh.desc.has_contacts() && want != 0 {
@@ -285,8 +306,8 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
             // A copy: a reference would keep `carried` in memory, and its
             // switches from folding.
             let mass_index = carried.masses().then_some(carried.mass_index);
-            contacts::<D, CELLS>(sh, &*b, &mut changes, want, targets, mass_index, Q::UNIT, Q::FINE, &mut self.counters);
-            round_apart::<Q, D, CELLS>(&changes, b, rng);
+            contacts::<D, CELLS>(sh, &*b, &mut changes, want, targets, mass_index, w.unit, w.fine, &mut self.counters);
+            round_apart::<W, D, CELLS>(&changes, b, sh, rng);
         }
         // Nothing to write where nobody moves and no velocity changed. Not
         // tested with `small-step`: the write back below changes nothing
@@ -298,7 +319,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
             return;
         }
         let mut after = 0u8;
-        each_occupied!(!P::ALL && (Q::LANES || D == 2), CELLS, occ, c => {
+        each_occupied!(!P::ALL && (!w.wide() || D == 2), CELLS, occ, c => {
             let t = (targets >> (4 * c) & 7) as usize;
             if P::ALL && site.open >> t & 1 != 0 {
                 self.counters.exited += 1; // M4 open face
@@ -308,7 +329,7 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
                 after |= 1 << t;
                 let to = site.cell(t);
                 if t != c || b.dirty() >> c & 1 != 0 {
-                    self.planes.velocity.set(to, b.to_plane(c));
+                    b.write(&self.planes.velocity, sh, c, to);
                 }
                 if carried.masses() && t != c {
                     self.planes.mass_index.set(to, carried.mass_index[c]);
@@ -328,9 +349,9 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
     /// [`Kernel::finish`] out of line, for a plain block, as
     /// [`Kernel::change_apart`].
     #[inline(never)]
-    fn finish_apart<P: Parts, R: Plane<Q, D>>(&mut self, row: &BlockRow, x0: usize, mut b: R, want: u32, rng: &mut Stream) {
+    fn finish_apart<W: Widths, P: Parts, R: Plane<W, D>>(&mut self, row: &BlockRow, x0: usize, mut b: R, want: u32, rng: &mut Stream) {
         debug_assert!(!P::ALL);
-        self.finish::<P, R>(&Site::plain(row, x0), &mut b, &Carried::none(), want, rng);
+        self.finish::<W, P, R>(&Site::plain(row, x0), &mut b, &Carried::none(), want, rng);
     }
 
     /// Sets and clears the block's occupancy bits from `before` to `after`:
@@ -390,20 +411,21 @@ impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
         site
     }
 
-    /// The pipeline with [`Every`] part, for any block.
+    /// The pipeline with [`Every`] part, for any block, of width `W`.
     #[inline(never)]
-    fn general(&mut self, row: &BlockRow, x0: isize, bx: usize, occ: u8) {
+    fn general<W: Widths>(&mut self, row: &BlockRow, x0: isize, bx: usize, occ: u8) {
         let site = self.site(row, x0);
-        let b = Block::load(self.planes.velocity, row, site.xs, occ);
-        self.local_map::<Every, Block<D, CELLS>>(&site, row.index + bx as u64, b);
+        let b = W::load(&self.planes.velocity, self.shared, row, site.xs, occ);
+        self.local_map::<W, Every, Block<D, CELLS>>(&site, row.index + bx as u64, b);
     }
 }
 
-impl<'a, Q: Quant, const D: usize, const CELLS: usize> BlockSink<'a> for Kernel<'a, Q, D, CELLS> {
+impl<'a, Q: Typed, const D: usize, const CELLS: usize> BlockSink<'a> for Sink<'a, Q, D, CELLS> {
     const CELLS: usize = CELLS;
 
     fn index(&self) -> Index<'a> {
-        Index { occupancy: self.planes.occupancy, rows: self.planes.rows, words: self.planes.words }
+        let planes = &self.kernel.planes;
+        Index { occupancy: planes.occupancy, rows: planes.rows, words: planes.words }
     }
 
     type Plan = RowPlan;
@@ -416,14 +438,14 @@ impl<'a, Q: Quant, const D: usize, const CELLS: usize> BlockSink<'a> for Kernel<
         if cfg!(feature = "small-step") {
             return RowPlan { lean_below: 0, obstacles: false };
         }
-        let sh = self.shared;
+        let sh = self.kernel.shared;
         // 2D, 8 bits: lanes or every part (worlds with contacts among
         // them), never plain cells, which are then left out. Every
         // x0 < n - 1 reads cells x0 and x0 + 1 of both domain rows, which
         // lie in the velocity plane (checked here, once a row: lanes are
         // read unchecked).
         let lean = if D == 2 && Q::LANES {
-            sh.lanes && row.cell[0].max(row.cell[1]) <= self.planes.velocity.len().saturating_sub(sh.n[0])
+            sh.lanes && row.cell[0].max(row.cell[1]) <= Q::plane(&self.kernel.planes.velocity).len().saturating_sub(sh.n[0])
         } else {
             sh.plain
         };
@@ -436,25 +458,40 @@ impl<'a, Q: Quant, const D: usize, const CELLS: usize> BlockSink<'a> for Kernel<
         // With `small-step` every part alone (the plain instantiations left
         // out of the build).
         if cfg!(feature = "small-step") {
-            return self.general(row, x0, bx, occ);
+            return self.every(row, x0, bx, occ);
         }
         // The half block's x0 = -1 is usize::MAX here, and the block that
         // wraps round a periodic x axis has x0 = n - 1: both fail the test
         // (a plain block's row holds two neighbouring cells).
         let x = x0 as usize;
+        let k = &mut self.kernel;
         // A world with obstacles: only blocks without one are plain.
-        if x < plan.lean_below && (!plan.obstacles || read_block::<CELLS>(self.shared.obstacle, row, [x, x + 1]) == 0) {
+        if x < plan.lean_below && (!plan.obstacles || read_block::<CELLS>(k.shared.obstacle, row, [x, x + 1]) == 0) {
             let site = Site::plain(row, x);
             let index = row.index + bx as u64;
             if D == 2 && Q::LANES {
                 // SAFETY: x < lean_below: `plan` checked the row's cells.
-                let b = unsafe { Lanes::load(self.planes.velocity, row, x, occ) };
-                return self.local_map::<Bare, Lanes>(&site, index, b);
+                let b = unsafe { Lanes::load(Q::plane(&k.planes.velocity), row, x, occ) };
+                return k.local_map::<Q, Bare, Lanes>(&site, index, b);
             }
-            let b = Block::load(self.planes.velocity, row, site.xs, occ);
-            return self.local_map::<Plain, Block<D, CELLS>>(&site, index, b);
+            let b = Q::load(&k.planes.velocity, k.shared, row, site.xs, occ);
+            return k.local_map::<Q, Plain, Block<D, CELLS>>(&site, index, b);
         }
-        self.general(row, x0, bx, occ);
+        self.every(row, x0, bx, occ);
+    }
+}
+
+impl<Q: Typed, const D: usize, const CELLS: usize> Sink<'_, Q, D, CELLS> {
+    /// The pipeline with every part for block `x0` of `row`: one copy for
+    /// both widths, which reads the step's ([`AnyWidth`]). With
+    /// `small-step`, `Q`'s own: a firmware build holds one width, and
+    /// every block comes here.
+    #[inline(always)]
+    fn every(&mut self, row: &BlockRow, x0: isize, bx: usize, occ: u8) {
+        #[cfg(not(feature = "small-step"))]
+        self.kernel.general::<AnyWidth>(row, x0, bx, occ);
+        #[cfg(feature = "small-step")]
+        self.kernel.general::<Q>(row, x0, bx, occ);
     }
 }
 

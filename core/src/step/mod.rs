@@ -3,11 +3,12 @@
 //! counters and the step number.
 //!
 //! The description fixes, once per step, how the block pipeline
-//! ([`Kernel`]) is instantiated (M9): the stored velocity width and the
-//! dimension are compile-time parameters; the force path and the optional
-//! parts are switches read once per block at most, and a world without
-//! them sends its blocks through the plain instantiations, which have no
-//! code for them.
+//! ([`Kernel`]) is instantiated (M9): the dimension is a compile-time
+//! parameter, and so is the stored velocity width for the plain
+//! instantiations (the one with every part reads it from the step's
+//! data); the force path and the optional parts are switches read once per
+//! block at most, and a world without them sends its blocks through the
+//! plain instantiations, which have no code for them.
 
 
 pub(crate) mod assign;
@@ -30,17 +31,18 @@ pub(crate) mod tasks;
 
 use crate::rules::fixed::{divr, magnitude, quot, scaled, scaled_by, to_fine, unit_scale};
 use crate::rules::force::{Flow, ForceTerms, Strength, Swirl};
-use crate::rules::quant::Quant;
+use crate::rules::quant::{Quant, Width};
 use crate::rules::rng::StepKey;
 use crate::rules::class::Class;
 #[cfg(feature = "identity")]
 use crate::step::block::Identified;
-use crate::step::block::{Shared, Writable};
+use crate::step::block::{Shared, Typed, Velocity, Writable};
 use crate::step::block::Kernel;
+use crate::step::kernel::Sink;
 use crate::step::partition::Partition;
 use crate::storage::cells::Cells;
 use crate::storage::layout::Layout;
-use crate::storage::layout::{groups, masses_and_classes, view, Planes};
+use crate::storage::layout::{masses_and_classes, Planes};
 #[cfg(target_has_atomic = "8")]
 use crate::step::tasks::Host;
 use crate::storage::world::{Counters, World};
@@ -183,12 +185,12 @@ impl World {
     pub(crate) fn sweep_with<Q: Quant, const D: usize>(
         &mut self,
         route: Route,
-        visit: impl FnOnce(&Shared<'_>, Writable<'_, Q, D>, bool) -> Counters,
+        visit: impl FnOnce(&Shared<'_>, Writable<'_, D>, bool) -> Counters,
     ) {
         // The shared data read where `setup` wrote it (moved out, it would
         // be a copy of all of it).
         let s = self.setup(route, Q::UNIT);
-        let velocity = Cells::new(groups(view::<Q>(s.velocity)));
+        let velocity = Velocity::new(s.velocity, Width::of::<Q>());
         let planes = Writable { occupancy: s.occupancy, rows: s.rows, words: s.words, velocity, mass_index: s.mass_index, life: s.life };
         let c = visit(&s.shared, planes, route.reverse);
         count_step(s.counters, &c, s.shared.part.total_blocks());
@@ -268,6 +270,8 @@ impl World {
             desc: copy,
             n,
             part,
+            #[cfg(not(feature = "small-step"))]
+            width: Width::of_quantization(desc.quantization),
             key: StepKey::blocks(desc.seed, head.step),
             obstacle,
             // A build without obstacles has no surface entry to slice.
@@ -364,12 +368,12 @@ fn count_step(h: &mut Counters, c: &Counters, total: u64) {
     h.skipped = total - c.processed;
 }
 
-fn run<Q: Quant, const D: usize, const CELLS: usize>(w: &mut World, route: Route, split: Split<'_>) {
+fn run<Q: Typed, const D: usize, const CELLS: usize>(w: &mut World, route: Route, split: Split<'_>) {
     w.sweep_with::<Q, D>(route, |shared, planes, reverse| {
         let sweep = |band| {
-            let mut kernel = Kernel::<Q, D, CELLS> { shared, planes, counters: Counters::default() };
-            shared.part.sweep_band(&mut kernel, band, reverse, route.skip);
-            kernel.counters
+            let mut sink = Sink::<Q, D, CELLS>::new(Kernel { shared, planes, counters: Counters::default() });
+            shared.part.sweep_band(&mut sink, band, reverse, route.skip);
+            sink.kernel.counters
         };
         match split {
             #[cfg(target_has_atomic = "8")]

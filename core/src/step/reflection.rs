@@ -12,9 +12,8 @@ use crate::rules::body::{body_surface_at, CellTally, Tally};
 use crate::rules::fixed::sat;
 use crate::rules::obstacle::{axis_q30, dot_q30, normal_q30, reflect, surface_at, Surface};
 use crate::rules::class::Class;
-use crate::rules::quant::Quant;
 use crate::rules::rng::Stream;
-use crate::step::block::{Carried, Kernel, Shared, Site, Stored};
+use crate::step::block::{Carried, Kernel, Shared, Site, Stored, Widths};
 use crate::step::clamp::clamp_counted;
 use crate::step::rounding::round_one;
 use crate::storage::layout::{row_words, test_bit};
@@ -30,19 +29,20 @@ pub(crate) fn back_normal<const D: usize>(from: usize, to: usize) -> [i32; 3] {
     axis_q30(n)
 }
 
-impl<Q: Quant, const D: usize, const CELLS: usize> Kernel<'_, Q, D, CELLS> {
+impl<const D: usize, const CELLS: usize> Kernel<'_, D, CELLS> {
     /// M5.4 for the particle in cell `c` of `b`, which wants to cross the
     /// axes `m`: whether the cell it wants is blocked, in which case its
     /// velocity is reflected ([`reflect_off`]) and rounded at once (M1),
     /// and it stays.
     #[inline(always)]
-    pub(crate) fn reflects(&mut self, site: &Site<'_>, b: &mut impl Stored<D>, c: usize, m: u8, carried: &Carried<CELLS>, rng: &mut Stream) -> bool {
+    pub(crate) fn reflects<W: Widths>(&mut self, site: &Site<'_>, b: &mut impl Stored<D>, c: usize, m: u8, carried: &Carried<CELLS>, rng: &mut Stream) -> bool {
         let t = c ^ usize::from(m);
         if m == 0 || site.blocked >> t & 1 == 0 {
             return false;
         }
-        if let Some(x) = reflect_off(self.shared, b.fine(c, Q::FINE), c, Wanted { site, cell: t }, &carried.class(self.shared, c), Q::UNIT, &mut self.counters, D) {
-            round_one::<Q, D, CELLS>(b, c, x, rng);
+        let w = W::width(self.shared);
+        if let Some(x) = reflect_off(self.shared, b.fine(c, w.fine), c, Wanted { site, cell: t }, &carried.class(self.shared, c), w.unit, &mut self.counters, D) {
+            round_one::<W, D, CELLS>(b, c, x, self.shared, rng);
         }
         true
     }

@@ -4,7 +4,7 @@
 
 use core::mem::MaybeUninit;
 
-use crate::rules::quant::Quant;
+use crate::step::block::{Shared, Widths};
 use crate::rules::rng::Stream;
 use crate::step::block::{cells_of, Stored};
 
@@ -45,15 +45,17 @@ impl<const CELLS: usize> Changes<CELLS> {
         self.pending |= 1 << c;
     }
 
-    /// M1: rounds every changed velocity into `b`, one 64-bit output of
-    /// the stream each (32 bits in 2D), in cell order. Out of line with
-    /// `small-step`: one copy for every stage.
+    /// M1: rounds every changed velocity into `b`, stored at width `W`
+    /// (of the step `sh`), one 64-bit output of the stream each (32 bits
+    /// in 2D), in cell order. Out of line with `small-step`: one copy for
+    /// every stage.
     #[cfg_attr(feature = "small-step", inline(never))]
     #[cfg_attr(not(feature = "small-step"), inline(always))]
-    pub(crate) fn round<Q: Quant, const D: usize>(&self, b: &mut impl Stored<D>, rng: &mut Stream) {
+    pub(crate) fn round<W: Widths, const D: usize>(&self, b: &mut impl Stored<D>, sh: &Shared<'_>, rng: &mut Stream) {
+        let width = W::width(sh);
         for c in cells_of(self.pending) {
             // SAFETY: cell c is pending, so `set` wrote its entry.
-            b.put(c, Q::round::<D>(unsafe { self.x[c].assume_init() }, rng));
+            b.put(c, width.round::<D>(unsafe { self.x[c].assume_init() }, rng));
         }
     }
 }
@@ -61,16 +63,16 @@ impl<const CELLS: usize> Changes<CELLS> {
 /// [`Changes::round`] out of line, after the stages that seldom change a
 /// velocity: a reflection (M5.4) and contacts (M5.7).
 #[inline(never)]
-pub(crate) fn round_apart<Q: Quant, const D: usize, const CELLS: usize>(changes: &Changes<CELLS>, b: &mut impl Stored<D>, rng: &mut Stream) {
-    changes.round::<Q, D>(b, rng);
+pub(crate) fn round_apart<W: Widths, const D: usize, const CELLS: usize>(changes: &Changes<CELLS>, b: &mut impl Stored<D>, sh: &Shared<'_>, rng: &mut Stream) {
+    changes.round::<W, D>(b, sh, rng);
 }
 
 /// M1 for one velocity `x` (fine units): the particle in cell `c` after
 /// its reflection (M5.4), which is rare, through [`round_apart`] (out of
 /// line; one copy serves this and the contacts).
 #[inline(always)]
-pub(crate) fn round_one<Q: Quant, const D: usize, const CELLS: usize>(b: &mut impl Stored<D>, c: usize, x: [i32; 3], rng: &mut Stream) {
+pub(crate) fn round_one<W: Widths, const D: usize, const CELLS: usize>(b: &mut impl Stored<D>, c: usize, x: [i32; 3], sh: &Shared<'_>, rng: &mut Stream) {
     let mut changes = Changes::<CELLS>::new();
     changes.set(c, x);
-    round_apart::<Q, D, CELLS>(&changes, b, rng);
+    round_apart::<W, D, CELLS>(&changes, b, sh, rng);
 }
