@@ -229,9 +229,9 @@ echo "budgets (opt-level z): .text <= $TEXT_BUDGET on each core (enforced on: $E
 if [ "$table" = 1 ] && command -v valgrind >/dev/null; then
     cg="$out/host.callgrind"
     valgrind --tool=callgrind --callgrind-out-file="$cg" --collect-atstart=no \
-        --toggle-collect='*World*step_in_order*' target/release/firmware_hash >/dev/null 2>&1
+        --toggle-collect='*World*step_forward*' target/release/firmware_hash >/dev/null 2>&1
     awk -v s="$steps" -v b="$blocks" '/^(summary|totals):/ {
-        printf "host (x86-64, callgrind, World::step_in_order): %.0f instr/step, %.0f instr/block\n", $2 / s, $2 / b; exit }' "$cg"
+        printf "host (x86-64, callgrind, World::step_forward): %.0f instr/step, %.0f instr/block\n", $2 / s, $2 / b; exit }' "$cg"
 fi
 
 if [ "$failures" != 0 ]; then

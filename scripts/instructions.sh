@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Instructions per processed block of the paper's scenes, counted by
-# valgrind's callgrind inside World::step_in_order only (building the world
+# valgrind's callgrind inside World::step_forward only (building the world
 # and the benchmark's own loop are not counted). Instruction counts do not
 # depend on the machine's load, unlike times, so they are the figure to
 # compare between commits.
@@ -144,7 +144,7 @@ printf '%-12s %14s %12s %16s\n' scene instructions blocks "instr/block"
 for scene in "${scenes[@]}"; do
     line=$(MPCA_BENCH_SCENE=$scene MPCA_BENCH_RUNS=1 valgrind --tool=callgrind \
         --callgrind-out-file="$out/$scene.cg" --collect-atstart=no \
-        --toggle-collect='*World*step_in_order*' "$bench" 2>/dev/null | awk -v s="$scene" '$1 == s')
+        --toggle-collect='*World*step_forward*' "$bench" 2>/dev/null | awk -v s="$scene" '$1 == s')
     [ -n "$line" ] || { echo "instructions: no benchmark line for '$scene'" >&2; exit 1; }
     blocks=$(echo "$line" | awk '{print $NF}')
     instr=$(awk '/^(summary|totals):/{print $2; exit}' "$out/$scene.cg")

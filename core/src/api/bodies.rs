@@ -6,6 +6,10 @@
 //! A change is checked in full (the shape, the speed, the room in the body
 //! surface table for the world as it will be) before anything is written,
 //! so a refused call leaves the world as it was.
+//!
+//! Every call here is made between steps, rarely: the helpers that several
+//! of them share stay out of line (`#[inline(never)]`), one copy each, so
+//! that the C library that holds them stays small.
 
 use crate::Error;
 use crate::rules::body::{for_ring, pushed_velocity, Body, BodiesHead, BodySurface, Tally};
@@ -13,13 +17,13 @@ use crate::rules::class::Class;
 use crate::rules::faces::Beyond;
 use crate::rules::fixed::{magnitude, to_fine, unit_scale};
 use crate::rules::obstacle::{centre, normal_q30, Shape};
-use crate::rules::quant::{with_quant, Quant};
+use crate::rules::quant::{with_quant, Quant, Width};
 use crate::rules::rng::StepKey;
 use crate::rules::vector::{dot, normalise};
 use crate::api::obstacles::{Frame, Mask};
 use crate::step::clamp::clamp_counted;
 use crate::storage::cells::Cells;
-use crate::storage::layout::{head_and_bodies, mark, put_bit, view_ref, Site};
+use crate::storage::layout::{head_and_bodies, mark, put_bit, store, view_ref, Site};
 use crate::storage::world::World;
 
 /// What a body gave the particles in the last step (M13): reflections off
@@ -64,12 +68,14 @@ pub(crate) struct Draw<'a> {
 impl Draw<'_> {
     /// The body that covers cell `c`: the first in table order whose shape
     /// holds its centre, unless a static obstacle does.
+    #[inline(never)]
     pub(crate) fn owner(&self, c: [usize; 3]) -> Option<(usize, Body)> {
         let first = (0..self.count).map(|i| (i, (self.body)(i))).find(|(_, b)| b.shape().is_some_and(|s| s.contains(centre(c), self.frame.dim)));
         first.filter(|_| !(self.is_static)(c))
     }
 
     /// The box of cells, per axis `lo..hi`, that holds every body's cells.
+    #[inline(never)]
     fn body_box(&self) -> ([usize; 3], [usize; 3]) {
         let (n, dim) = (self.frame.n, self.frame.dim);
         let (mut lo, mut hi) = (n, [0; 3]);
@@ -87,16 +93,18 @@ impl Draw<'_> {
     /// The body surface entry of cell `c`, covered by body `i`, where
     /// `taken` says which cells are obstacles (static or a body's): none
     /// where no neighbour is free (M13).
+    #[inline(never)]
     fn entry(&self, taken: Mask<'_>, c: [usize; 3], i: usize, b: &Body) -> Option<BodySurface> {
         if !self.frame.is_surface(c, taken) {
             return None;
         }
-        let normal = normalise(push_normal(b, c, self.frame.dim)).unwrap_or([1.0, 0.0, 0.0]);
+        let normal = push_normal(b, c, self.frame.dim);
         let n = self.frame.n;
         Some(BodySurface { cell: (c[0] + n[0] * (c[1] + n[1] * c[2])) as u32, normal, restitution: b.restitution, body: i as u32 })
     }
 
     /// The entries the body surface table needs for these bodies.
+    #[inline(never)]
     pub(crate) fn entries(&self) -> usize {
         let taken = |q: [usize; 3]| (self.is_static)(q) || self.owner(q).is_some();
         let (lo, hi) = self.body_box();
@@ -162,9 +170,9 @@ impl World {
         self.bodies().ok().map(|(h, _)| (h.crushed, h.redraws))
     }
 
-    /// Calls `f` with every slot of the body table, free ones too.
-    pub(crate) fn each_body(&self, f: &mut dyn FnMut(&Body)) {
-        self.bodies().map_or(&[][..], |(_, t)| t).iter().for_each(f);
+    /// Every slot of the body table, free ones too; none without bodies.
+    pub(crate) fn body_table(&self) -> &[Body] {
+        self.bodies().map_or(&[][..], |(_, t)| t)
     }
 
     /// Word `i` of the body cell plane, 0 without bodies.
@@ -202,6 +210,7 @@ impl World {
     }
 
     /// What body `id` gave the particles in the last step.
+    #[inline(never)]
     pub fn body_stats(&self, id: u32) -> Result<BodyStats, Error> {
         let t = self.body(id)?.last;
         // M13: the tally counts each particle's relative mass in 24 bits
@@ -223,16 +232,19 @@ impl World {
     }
 
     /// The largest mass in use: the world's, or the largest in its table.
+    #[inline(never)]
     fn largest_mass(&self) -> f32 {
         if !self.head.desc.has_masses() {
             return self.head.desc.mass;
         }
+        // Masses are positive (checked): their bits order them as numbers.
         let table: &[f32] = self.plane(self.layout().mass_table());
-        table[..self.head.masses as usize].iter().fold(self.head.desc.mass, |a, &m| a.max(m))
+        f32::from_bits(table[..self.head.masses as usize].iter().fold(self.head.desc.mass.to_bits(), |a, &m| a.max(m.to_bits())))
     }
 
     /// `body` with its velocity in fine units (M13: converted as the uniform
     /// wind is, once, since a world's unit never changes).
+    #[inline(never)]
     fn with_fine_velocity(&self, mut body: Body) -> Body {
         let scale = unit_scale(self.unit());
         body.fine = body.velocity.map(|u| to_fine(u, scale));
@@ -242,7 +254,7 @@ impl World {
     /// Calls `f` with what drawing the bodies reads of this world, with
     /// `change` made to its table (none: `slot` past the table).
     fn with_draw<R>(&self, change: Change, f: impl FnOnce(&Draw<'_>) -> R) -> R {
-        let table = self.bodies().map_or(&[][..], |(_, t)| t);
+        let table = self.body_table();
         let l = *self.layout();
         let body = |i: usize| if i == change.slot { change.body } else { table[i] };
         let is_static = |c: [usize; 3]| self.is_static(l.site(c[0], c[1], c[2]));
@@ -272,6 +284,7 @@ impl World {
     /// a static obstacle, and the body surface table rebuilt from them in
     /// cell order. Also where static obstacles changed around the bodies
     /// (M7 additions), which can only take entries away.
+    #[inline(never)]
     pub(crate) fn refresh_bodies(&mut self) {
         if self.bodies().is_err() {
             return;
@@ -312,6 +325,7 @@ impl World {
     /// M13's push-out of every particle in a body cell, in cell order: to
     /// the first free candidate cell, its velocity into the surface
     /// (relative to it) removed, or crushed where none is free.
+    #[inline(never)]
     fn push_out(&mut self) {
         let l = *self.layout();
         let (dim, frame) = (self.dim(), self.frame());
@@ -331,7 +345,7 @@ impl World {
             let n = push_normal(&b, c, dim);
             let to = self.free_candidate(&frame, c, n);
             let index = u64::from(head.redraws) * l.cells as u64 + from.cell as u64;
-            self.push_one(from, to, i, &b, normal_q30(normalise(n).unwrap_or([1.0, 0.0, 0.0])), &mut key.stream(index));
+            self.push_one(from, to, i, &b, normal_q30(n), &mut key.stream(index));
         });
     }
 
@@ -343,26 +357,24 @@ impl World {
     fn free_candidate(&self, frame: &Frame, c: [usize; 3], n: [f32; 3]) -> Option<Site> {
         let l = self.layout();
         for ring in 1..=2 {
-            // At most the 5^3 - 3^3 offsets of ring 2.
-            let mut list = [(0.0f32, 0i32, 0usize); 98];
-            let mut len = 0;
+            // The first free cell in that order: the free one that orders
+            // first, found in one pass.
+            let mut best: Option<(f32, i32, usize)> = None;
             for_ring(frame.dim, ring, &mut |d| {
                 let key = dot(d.map(|v| v as f32), n);
-                if key < 0.0 {
+                let Beyond::Inside(p) = frame.beyond(c, d) else { return };
+                let s = l.site(p[0], p[1], p[2]);
+                if key < 0.0 || self.is_obstacle(s) || self.occupied(s) {
                     return;
                 }
-                if let Beyond::Inside(p) = frame.beyond(c, d) {
-                    list[len] = (key, d.iter().map(|v| v * v).sum(), l.site(p[0], p[1], p[2]).cell);
-                    len += 1;
+                let this = (key, d.iter().map(|v| v * v).sum(), s.cell);
+                let first = |b: (f32, i32, usize)| this.0 > b.0 || (this.0 == b.0 && (this.1, this.2) < (b.1, b.2));
+                if best.is_none_or(first) {
+                    best = Some(this);
                 }
             });
-            let list = &mut list[..len];
-            list.sort_unstable_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)).then(a.2.cmp(&b.2)));
-            for &(_, _, cell) in list.iter() {
-                let s = self.site_of(cell);
-                if !self.is_obstacle(s) && !self.occupied(s) {
-                    return Some(s);
-                }
+            if let Some((_, _, cell)) = best {
+                return Some(self.site_of(cell));
             }
         }
         None
@@ -377,6 +389,7 @@ impl World {
     /// Moves the particle at `from` to `to` with M13's velocity for a body
     /// `b` (slot `i`) of unit normal `n` (Q30), tallied; or, with no `to`,
     /// removes it as crushed.
+    #[inline(never)]
     fn push_one(&mut self, from: Site, to: Option<Site>, i: usize, b: &Body, n: [i32; 3], rng: &mut crate::rules::rng::Stream) {
         let class = self.class_at(from.cell);
         let Some(to) = to else {
@@ -393,48 +406,58 @@ impl World {
         let dim = self.dim();
         let summary_words = self.layout().summary_words;
         let (lifetimes, masses) = (self.head.desc.lifetimes, self.head.desc.has_masses());
-        with_quant!(self.head.desc.quantization, Q => {
-            let (head, p) = self.planes::<Q>();
-            let mut v = [0i32; 3];
-            for k in 0..dim {
-                v[k] = p.velocity[from.cell * dim + k].to_int() << Q::FINE;
+        // The velocities as bytes of the world's width: one copy of this for
+        // both widths.
+        let width = with_quant!(self.head.desc.quantization, Q => Width::of::<Q>());
+        let bytes = if width.wide() { 2 } else { 1 };
+        let (head, p) = self.planes::<u8>();
+        let read = |plane: &[u8], i: usize| if bytes == 2 { i32::from(i16::from_ne_bytes([plane[2 * i], plane[2 * i + 1]])) } else { i32::from(plane[i] as i8) };
+        let mut v = [0i32; 3];
+        for k in 0..dim {
+            v[k] = read(p.velocity, from.cell * dim + k) << width.fine;
+        }
+        let mut x = pushed_velocity(v, b.fine, n);
+        clamp_counted::<3>(&mut x, width.unit, &class, &mut head.counters);
+        // M1: 32 bits in 2D, a whole output in 3D, as the step rounds.
+        let stored = if dim == 2 {
+            let r = width.round::<2>(x, rng);
+            [r[0], r[1], 0]
+        } else {
+            width.round::<3>(x, rng)
+        };
+        for k in 0..dim {
+            store(p.velocity, to.cell * dim + k, bytes, stored[k]);
+        }
+        put_bit(Cells::new(p.occupancy), from.bit, false);
+        put_bit(Cells::new(p.occupancy), to.bit, true);
+        mark(Cells::new(p.rows), Cells::new(p.words), summary_words, to.row, to.x);
+        if masses {
+            p.mass_index[to.cell] = p.mass_index[from.cell];
+        }
+        if lifetimes {
+            p.life[to.cell] = p.life[from.cell];
+        }
+        #[cfg(feature = "identity")]
+        {
+            let on = head.desc.identity_planes();
+            if on.ids() {
+                p.id[to.cell] = p.id[from.cell];
             }
-            let mut x = pushed_velocity(v, b.fine, n);
-            clamp_counted::<3>(&mut x, Q::UNIT, &class, &mut head.counters);
-            let stored = Q::round::<3>(x, rng);
-            for k in 0..dim {
-                p.velocity[to.cell * dim + k] = Q::from_int(stored[k]);
+            if on.ages() {
+                p.age[to.cell] = p.age[from.cell];
             }
-            put_bit(Cells::new(p.occupancy), from.bit, false);
-            put_bit(Cells::new(p.occupancy), to.bit, true);
-            mark(Cells::new(p.rows), Cells::new(p.words), summary_words, to.row, to.x);
-            if masses {
-                p.mass_index[to.cell] = p.mass_index[from.cell];
+            if on.tags() {
+                p.tag[to.cell] = p.tag[from.cell];
             }
-            if lifetimes {
-                p.life[to.cell] = p.life[from.cell];
-            }
-            #[cfg(feature = "identity")]
-            {
-                let on = head.desc.identity_planes();
-                if on.ids() {
-                    p.id[to.cell] = p.id[from.cell];
-                }
-                if on.ages() {
-                    p.age[to.cell] = p.age[from.cell];
-                }
-                if on.tags() {
-                    p.tag[to.cell] = p.tag[from.cell];
-                }
-            }
-            let t = &mut head_and_bodies(p.bodies).1[i].current;
-            t.pushed = t.pushed.wrapping_add(1);
-            t.add_change(class.relative, [0, 1, 2].map(|k| x[k] - v[k]));
-        });
+        }
+        let t = &mut head_and_bodies(p.bodies).1[i].current;
+        t.pushed = t.pushed.wrapping_add(1);
+        t.add_change(class.relative, [0, 1, 2].map(|k| x[k] - v[k]));
     }
 
     /// The class (M1c) of the particle in `cell`, as the step converts it:
     /// its relative mass and the clamp's energy factor.
+    #[inline(never)]
     fn class_at(&self, cell: usize) -> Class {
         let d = &self.head.desc;
         let m = magnitude(self.mass_at(cell));
@@ -477,16 +500,10 @@ fn for_cells(lo: [usize; 3], hi: [usize; 3], f: &mut dyn FnMut([usize; 3])) {
     }
 }
 
-/// The outward normal M13 takes at cell `c` of body `b`, unnormalised: the
-/// shape's geometry at the cell's centre, else the body's velocity, else
-/// `+x`.
+/// The unit outward normal M13 takes at cell `c` of body `b`: the shape's
+/// geometry at the cell's centre, else the body's velocity, else `+x`.
+#[inline(never)]
 fn push_normal(b: &Body, c: [usize; 3], dim: usize) -> [f32; 3] {
     let n = b.shape().map_or([0.0; 3], |s| s.normal(centre(c), dim));
-    if n != [0.0; 3] {
-        n
-    } else if b.velocity != [0.0; 3] {
-        b.velocity
-    } else {
-        [1.0, 0.0, 0.0]
-    }
+    normalise(n).or(normalise(b.velocity)).unwrap_or([1.0, 0.0, 0.0])
 }

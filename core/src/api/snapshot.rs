@@ -1033,7 +1033,7 @@ impl World {
         self.plane::<Surface>(l.surface())[..h.surfaces as usize].iter().for_each(|s| put_surface(&mut p, s));
         self.plane::<Slot>(l.emitters())[..h.emitters as usize].iter().for_each(|s| put_slot(&mut p, s));
         #[cfg(feature = "obstacles")]
-        self.each_body(&mut |b| put_body(&mut p, b));
+        self.body_table().iter().for_each(|b| put_body(&mut p, b));
         let crc = crc32(&p.out[..len - CHECKSUM]);
         p.u32(crc);
         debug_assert_eq!(p.at, len);

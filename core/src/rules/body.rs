@@ -129,6 +129,7 @@ impl Body {
 
     /// Gives the body a new shape and velocity (checked), keeping its
     /// restitution and tallies.
+    #[inline(never)]
     pub(crate) fn set(&mut self, shape: Shape, u: [f32; 3], dim: usize) -> Result<(), Error> {
         shape.check(dim)?;
         finite(&u)?;
@@ -136,7 +137,9 @@ impl Body {
         if dim == 2 {
             u[2] = 0.0;
         }
-        if u[0] * u[0] + u[1] * u[1] + u[2] * u[2] > 1.0 {
+        // Decided exactly, as for a particle's velocity: a speed of 1 is
+        // taken, whatever the rounding of a sum of squares would say.
+        if !crate::api::speed::slow(&u[..dim]) {
             return Err(Error::SpeedRange);
         }
         // Kind 0 is a free slot: a shape's kind is stored one up.

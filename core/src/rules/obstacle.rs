@@ -296,10 +296,14 @@ impl Shape {
         let mut a = [0usize; 3];
         let mut b = n;
         for k in 0..dim {
-            // Centre i + 0.5 >= lo  <=>  i >= lo - 0.5; float-to-int casts
-            // saturate, so huge shapes are clipped to the world.
-            a[k] = (libm::floorf(lo[k] - 0.5).max(0.0) as usize).min(n[k]);
-            b[k] = ((libm::floorf(hi[k] - 0.5) + 1.0).max(0.0) as usize).min(n[k]);
+            // Centre i + 0.5 >= lo  <=>  i >= lo - 0.5: from floor(lo - 0.5)
+            // to floor(hi - 0.5) inclusive, clipped to the world. Below 0
+            // the floor is clipped anyway, and above it the cast truncates,
+            // which is the floor there; float-to-int casts saturate, so
+            // huge shapes are clipped too.
+            let (from, to) = (lo[k] - 0.5, hi[k] - 0.5);
+            a[k] = if from > 0.0 { (from as usize).min(n[k]) } else { 0 };
+            b[k] = if to >= 0.0 { (to as usize).saturating_add(1).min(n[k]) } else { 0 };
         }
         (a, b)
     }

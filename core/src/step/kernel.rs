@@ -20,7 +20,8 @@
 //!   and off by the description at run time (the faces, obstacles, masses,
 //!   lifetimes, summed forces, drag, contacts), or a plain world's block
 //!   away from the faces and obstacles ([`Plain`], and [`Bare`] without
-//!   contacts), whose cells are unrolled;
+//!   contacts), whose cells are unrolled (not for 16-bit 3D worlds, whose
+//!   blocks all take [`Every`]: the C library's size budget);
 //! - the block's representation ([`Plane`]): per-cell arrays ([`Block`]),
 //!   or, for the plain 2D block of an 8-bit world, one word of byte lanes
 //!   ([`Lanes`]), whose rarer stages run out of line;
@@ -444,10 +445,13 @@ impl<'a, Q: Typed, const D: usize, const CELLS: usize> BlockSink<'a> for Sink<'a
         // x0 < n - 1 reads cells x0 and x0 + 1 of both domain rows, which
         // lie in the velocity plane (checked here, once a row: lanes are
         // read unchecked).
+        // 3D, 16 bits: every part, never plain cells either: the room the
+        // C library's budget keeps for new rules (the README measures what
+        // it costs such worlds).
         let lean = if D == 2 && Q::LANES {
             sh.lanes && row.cell[0].max(row.cell[1]) <= Q::plane(&self.kernel.planes.velocity).len().saturating_sub(sh.n[0])
         } else {
-            sh.plain
+            sh.plain && (D == 2 || Q::LANES)
         };
         let lean = lean && row.outside == 0;
         RowPlan { lean_below: if lean { sh.n[0] - 1 } else { 0 }, obstacles: sh.desc.has_obstacles() }

@@ -64,32 +64,70 @@ type Split<'h> = Option<(usize, Host<'h>)>;
 #[cfg(not(target_has_atomic = "8"))]
 type Split<'h> = Option<(usize, core::marker::PhantomData<&'h ()>)>;
 
-/// How a step visits its blocks: in which order, and whether blocks of a
-/// plain world may take a plain instantiation of the pipeline.
-#[derive(Clone, Copy)]
-pub(crate) struct Route {
-    reverse: bool,
-    lean: bool,
-    /// Skip rows and words the summaries say are empty.
-    skip: bool,
+/// How a step visits its blocks: in which order, whether blocks of a plain
+/// world may take a plain instantiation of the pipeline, and whether rows
+/// and words the summaries say are empty are skipped. A type, so that a
+/// build holds the sweeps of the routes it takes and no other: the C
+/// library steps forward only.
+pub(crate) trait Route {
+    const REVERSE: bool;
+    const LEAN: bool;
+    const SKIP: bool;
+}
+
+/// The step every caller takes.
+pub(crate) enum Forward {}
+impl Route for Forward {
+    const REVERSE: bool = false;
+    const LEAN: bool = true;
+    const SKIP: bool = true;
+}
+
+/// [`Order::Reverse`]: the tests' proof that the order does not matter.
+pub(crate) enum Backward {}
+impl Route for Backward {
+    const REVERSE: bool = true;
+    const LEAN: bool = true;
+    const SKIP: bool = true;
+}
+
+/// [`World::step_reference`]: every block through the pipeline with every
+/// part, nothing skipped.
+#[cfg(any(test, feature = "reference"))]
+pub(crate) enum Reference {}
+#[cfg(any(test, feature = "reference"))]
+impl Route for Reference {
+    const REVERSE: bool = false;
+    const LEAN: bool = false;
+    const SKIP: bool = false;
 }
 
 impl World {
     /// Advances the world `n` steps.
     pub fn step(&mut self, n: u64) {
         for _ in 0..n {
-            self.step_in_order(Order::Forward);
+            self.step_forward();
         }
+    }
+
+    /// One step, forward: what [`World::step`] takes, apart from
+    /// [`World::step_in_order`] so that a caller of `step` alone (the C
+    /// library) holds no reverse sweep.
+    ///
+    /// Never inlined: `scripts/instructions.sh` and `scripts/firmware.sh`
+    /// count the instructions spent inside it.
+    #[inline(never)]
+    fn step_forward(&mut self) {
+        self.step_split::<Forward>(None);
     }
 
     /// Advances one step, visiting blocks in `order`. The result is the
     /// same bit for bit either way (M8).
-    ///
-    /// Never inlined: `scripts/instructions.sh` counts the instructions
-    /// spent inside it.
-    #[inline(never)]
     pub fn step_in_order(&mut self, order: Order) {
-        self.step_routed(Route { reverse: order == Order::Reverse, lean: true, skip: true });
+        match order {
+            Order::Forward => self.step_forward(),
+            Order::Reverse => self.step_split::<Backward>(None),
+        }
     }
 
     /// Advances one step with every block through the pipeline with every
@@ -100,7 +138,7 @@ impl World {
     /// the crate's own tests).
     #[cfg(any(test, feature = "reference"))]
     pub fn step_reference(&mut self) {
-        self.step_routed(Route { reverse: false, lean: false, skip: false });
+        self.step_split::<Reference>(None);
     }
 
     /// Advances one step split into at most `max_tasks` tasks (M11, at
@@ -126,7 +164,7 @@ impl World {
     /// ```
     #[cfg(target_has_atomic = "8")]
     pub fn step_parallel(&mut self, max_tasks: usize, host: Host<'_>) {
-        self.step_split(Route { reverse: false, lean: true, skip: true }, Some((max_tasks, host)));
+        self.step_split::<Forward>(Some((max_tasks, host)));
     }
 
     /// Advances `n` steps on `threads` threads of the standard library
@@ -157,18 +195,14 @@ impl World {
         }
     }
 
-    fn step_routed(&mut self, route: Route) {
-        self.step_split(route, None);
-    }
-
     /// One step, its sweep run whole or, with `split`, as tasks (M11).
-    fn step_split(&mut self, route: Route, split: Split<'_>) {
+    fn step_split<R: Route>(&mut self, split: Split<'_>) {
         self.emit();
         crate::rules::quant::with_quant!(self.head.desc.quantization, Q => {
             match self.head.desc.dim {
                 #[cfg(feature = "dim3")]
-                3 => run::<Q, 3, 8>(self, route, split),
-                _ => run::<Q, 2, 4>(self, route, split),
+                3 => run::<Q, R, 3, 8>(self, split),
+                _ => run::<Q, R, 2, 4>(self, split),
             }
         });
         #[cfg(feature = "obstacles")]
@@ -182,17 +216,13 @@ impl World {
     /// the writable planes, and adds the counters it returns to the world's.
     /// Only the velocity plane's view depends on the width: the rest is set
     /// up and counted once for every width ([`World::setup`]).
-    pub(crate) fn sweep_with<Q: Quant, const D: usize>(
-        &mut self,
-        route: Route,
-        visit: impl FnOnce(&Shared<'_>, Writable<'_, D>, bool) -> Counters,
-    ) {
+    pub(crate) fn sweep_with<Q: Quant, const D: usize>(&mut self, lean: bool, visit: impl FnOnce(&Shared<'_>, Writable<'_, D>) -> Counters) {
         // The shared data read where `setup` wrote it (moved out, it would
         // be a copy of all of it).
-        let s = self.setup(route, Q::UNIT);
+        let s = self.setup(lean, Q::UNIT);
         let velocity = Velocity::new(s.velocity, Width::of::<Q>());
         let planes = Writable { occupancy: s.occupancy, rows: s.rows, words: s.words, velocity, mass_index: s.mass_index, life: s.life };
-        let c = visit(&s.shared, planes, route.reverse);
+        let c = visit(&s.shared, planes);
         count_step(s.counters, &c, s.shared.part.total_blocks());
     }
 
@@ -200,7 +230,7 @@ impl World {
     /// unit speed (M1c). Out of line: one copy serves every width and
     /// dimension.
     #[inline(never)]
-    fn setup(&mut self, route: Route, unit: i32) -> Setup<'_> {
+    fn setup(&mut self, lean: bool, unit: i32) -> Setup<'_> {
         let part = Partition::new(self.layout(), &self.head.desc.boundary, self.dim(), self.head.step);
         // Read by the potential's gradient alone, which only `fields` has.
         let periodic = if cfg!(feature = "fields") { self.periodic() } else { [false; 3] };
@@ -261,7 +291,7 @@ impl World {
         let pushes = push[0] | push[1] | push[2] != 0;
         // With `small-step` every block takes the pipeline with every part:
         // nothing is plain, and nothing only the plain ones read is set up.
-        let lean = !cfg!(feature = "small-step") && route.lean;
+        let lean = !cfg!(feature = "small-step") && lean;
         let plain = lean && !desc.has_masses() && !desc.lifetimes && !desc.identity_planes().any() && !summed && small_push;
         let shared = Shared {
             #[cfg(feature = "small-step")]
@@ -368,11 +398,11 @@ fn count_step(h: &mut Counters, c: &Counters, total: u64) {
     h.skipped = total - c.processed;
 }
 
-fn run<Q: Typed, const D: usize, const CELLS: usize>(w: &mut World, route: Route, split: Split<'_>) {
-    w.sweep_with::<Q, D>(route, |shared, planes, reverse| {
+fn run<Q: Typed, R: Route, const D: usize, const CELLS: usize>(w: &mut World, split: Split<'_>) {
+    w.sweep_with::<Q, D>(R::LEAN, |shared, planes| {
         let sweep = |band| {
             let mut sink = Sink::<Q, D, CELLS>::new(Kernel { shared, planes, counters: Counters::default() });
-            shared.part.sweep_band(&mut sink, band, reverse, route.skip);
+            shared.part.sweep_band::<_, R>(&mut sink, band);
             sink.kernel.counters
         };
         match split {

@@ -21,6 +21,7 @@ use core::ops::Range;
 use crate::api::desc::Boundary;
 use crate::storage::cells::Cells;
 use crate::storage::layout::Layout;
+use crate::step::Route;
 
 
 /// One axis of a step's partition.
@@ -188,20 +189,21 @@ impl Partition {
     }
 
     /// Visits every block holding a particle in the rows of blocks of
-    /// `band` (all of them: `0..block_rows()`), forward (x fastest) or in
-    /// exactly the reverse order. Blocks are independent (M3), so both orders
+    /// `band` (all of them: `0..block_rows()`), forward (x fastest) or, on
+    /// the route `R` that says so, in exactly the reverse order. Blocks are independent (M3), so both orders
     /// leave the same world; the tests check it.
     ///
     /// Rows of blocks whose domain rows are all flagged empty are skipped,
     /// four at a time where eight rows of flags read as one word are zero;
     /// a row of blocks that is swept leaves its rows' flags exact.
     ///
-    /// With `skip` false every row and word is swept, whatever the
-    /// summaries say (the tests' reference).
+    /// On a route that does not skip, every row and word is swept, whatever
+    /// the summaries say (the tests' reference).
     ///
     /// The flags and summaries of rows outside the band are neither read
     /// nor written, so bands can be swept at the same time (M11).
-    pub fn sweep_band<'a, S: BlockSink<'a>>(&self, sink: &mut S, band: Range<usize>, reverse: bool, skip: bool) {
+    pub fn sweep_band<'a, S: BlockSink<'a>, R: Route>(&self, sink: &mut S, band: Range<usize>) {
+        let (reverse, skip) = (R::REVERSE, R::SKIP);
         if cfg!(feature = "small-step") {
             return self.sweep_band_small(sink, band, reverse);
         }

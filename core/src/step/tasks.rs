@@ -68,7 +68,12 @@ pub(crate) fn task_count(part: &Partition, max: usize) -> usize {
 /// every task's counters, added in task order.
 pub(crate) fn run(part: &Partition, max: usize, host: Host<'_>, sweep: &(dyn Fn(Range<usize>) -> Counters + Sync)) -> Counters {
     let count = task_count(part, max);
-    let slots: [Slot; MAX_TASKS] = core::array::from_fn(|_| Slot { state: AtomicU8::new(IDLE), counters: UnsafeCell::new(Counters::default()) });
+    // Every slot idle and counting nothing: zeros, which the array fills
+    // in one go. A constant, not a shared value: each slot of the array is
+    // a fresh copy of it, as an array repeat of a constant makes.
+    #[allow(clippy::declare_interior_mutable_const)]
+    const IDLE_SLOT: Slot = Slot { state: AtomicU8::new(IDLE), counters: UnsafeCell::new(Counters::ZERO) };
+    let slots: [Slot; MAX_TASKS] = [IDLE_SLOT; MAX_TASKS];
     let task = |i: usize| {
         let Some(slot) = slots[..count].get(i) else { return };
         if slot.state.compare_exchange(IDLE, RUNNING, Ordering::Acquire, Ordering::Relaxed).is_err() {

@@ -32,6 +32,21 @@ pub(crate) struct Counters {
 }
 
 impl Counters {
+    /// Nothing counted.
+    pub const ZERO: Counters = Counters {
+        particles: 0,
+        emitted: 0,
+        exited: 0,
+        expired: 0,
+        shortfall: 0,
+        collisions: 0,
+        clamps: 0,
+        clamp_energy: 0,
+        displaced: 0,
+        processed: 0,
+        skipped: 0,
+    };
+
     /// Adds what a sweep of blocks counts (a task's share of a step). The
     /// running totals saturate: an image (M12) may carry any count.
     pub fn add_step(&mut self, c: &Counters) {
