@@ -203,8 +203,12 @@ mpca_shape blade_shape(const geometry &g, float angle, int k, b2Vec2 *middle) {
                    (g.hub[1] + to * s) / CELL_M, r / CELL_M);
 }
 
-/* Turns a minute. */
-double rpm(const b2Body *b) { return static_cast<double>(b->GetAngularVelocity()) * 60.0 / (2.0 * PI_F); }
+/* Turns a minute, to a tenth (so a wheel at rest, turning a hair's breadth
+ * either way, prints 0.0 and not -0.0). */
+double rpm(const b2Body *b) {
+    const double r = std::round(static_cast<double>(b->GetAngularVelocity()) * 600.0 / (2.0 * PI_F)) / 10.0;
+    return r == 0.0 ? 0.0 : r;
+}
 
 /* What render() draws beside the world. */
 struct drawing {

@@ -477,7 +477,9 @@ fn wake_moves_a_disc_through_smoke_and_leaves_a_clear_strip_behind_it() {
     let x: f64 = momentum.split(',').next().unwrap().parse().expect("a number");
     assert!(x > 0.0, "the disc moves right and pushes the smoke right: {line}");
     let end = |stdout: &str| stdout.lines().find(|l| l.starts_with("end: ")).expect("an end: line").to_string();
-    let args = ["--size", "32", "--steps", "60", "--every", "0", "--tiles", "1", "--gif", "0"];
+    let out_dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("examples").join("wake-threads");
+    let out_s = out_dir.to_string_lossy().into_owned();
+    let args = ["--size", "32", "--steps", "60", "--every", "0", "--tiles", "1", "--gif", "0", "--out", &out_s];
     let serial = run("wake", &args);
     let mut threaded = args.to_vec();
     threaded.extend(["--threads", "2"]);
