@@ -345,7 +345,11 @@ int scene_main(const scene *s, int argc, char **argv) {
         }
         if (progress_next(&prog, o.steps) < next) next = progress_next(&prog, o.steps);
         double t0 = now_s();
-        scene_step(w, next - t, &o);
+        if (s->step) {
+            for (uint64_t k = t; k < next; k++) s->step(&o, w, k);
+        } else {
+            scene_step(w, next - t, &o);
+        }
         sim_s += now_s() - t0;
         t = next;
     }

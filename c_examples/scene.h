@@ -28,6 +28,11 @@ typedef struct scene {
     mpca_world *(*build)(const scene_opts *o);
     /* Draws the world into the current context (cleared already). */
     drawn (*draw)(const scene_opts *o, mpca_world *w, const view *v);
+    /* Takes step t (from t to t + 1) with what the scene moves around it,
+     * its bodies (M13) say, which the caller moves before every step; it
+     * steps the world with scene_step. NULL: scene_main steps on to the
+     * next frame in one call. */
+    void (*step)(const scene_opts *o, mpca_world *w, uint64_t t);
 } scene;
 
 /* Parses the options, builds the world, steps it, writes the frames and the

@@ -3,8 +3,10 @@
 # Ubuntu), builds libmpca and the C programs of c_examples/, runs the four
 # scenes at full size (and the smoke scene a second, longer time, and with
 # flow drag, M5.1b; and smoke-ids, smoke drawn between steps by id and
-# faded by age, M6b), and says where the images (PNG frames, contact
-# sheets, animated GIFs) are and how long the simulation took.
+# faded by age, M6b; and the moving bodies of M13: wake, a disc through
+# smoke, and box2d-wheel, a Box2D water wheel under a waterfall), and says
+# where the images (PNG frames, contact sheets, animated GIFs) are and how
+# long the simulation took.
 #
 #   scripts/run-scenes.sh [--out DIR] [--docs]
 #
@@ -14,9 +16,9 @@
 #               section (between its <!-- scenes:begin --> and
 #               <!-- scenes:end --> lines) with this machine's timings
 #
-# Needs only the Rust toolchain; make, libosmesa6-dev, libpng-dev and
-# libgif-dev are installed with apt-get when missing (as root, or through
-# sudo).
+# Needs only the Rust toolchain; make, libosmesa6-dev, libpng-dev,
+# libgif-dev and libbox2d-dev are installed with apt-get when missing (as
+# root, or through sudo).
 set -euo pipefail
 
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -51,7 +53,7 @@ make -C c_examples --no-print-directory MPCA_LIB="$lib" BUILD="$bin" CC="$cc"
 echo "== the scenes, full size, images in $out"
 logs=$(mktemp -d)
 trap 'rm -rf "$logs"' EXIT
-runs=(aggregation cluster smoke water smoke-long smoke-flow water-pool smoke-ids)
+runs=(aggregation cluster smoke water smoke-long smoke-flow water-pool smoke-ids wake box2d-wheel)
 # Images to be checked in are compressed harder: size matters there, the
 # time does not.
 png=()
@@ -134,7 +136,13 @@ if [ "$docs" -eq 1 ]; then
         smoke) echo "4.3 smoke";; water) echo "4.4 water";; smoke-long) echo "4.3 smoke, longer run";;
         smoke-flow) echo "4.3 smoke with flow drag (M5.1b, beyond the paper)";;
         water-pool) echo "4.4 water poured into a pool (M5.7 contacts, beyond the paper)";;
-        smoke-ids) echo "smoke tracked by id, faded by age (M6b, beyond the paper)";; esac; }
+        smoke-ids) echo "smoke tracked by id, faded by age (M6b, beyond the paper)";;
+        wake) echo "a ball through smoke (M13 bodies, beyond the paper)";;
+        box2d-wheel) echo "a Box2D water wheel under a waterfall (M13 bodies with Box2D, beyond the paper)";; esac; }
+    # A field of a program's own line in its log: field LOG PREFIX KEY.
+    field() { grep "^$2" "$1" | head -n 1 | tr ' ' '\n' | sed -n "s/^$3=//p"; }
+    # -46.6 -> 46.6
+    unsign() { echo "${1#-}"; }
     caption() { case "$1" in
         aggregation) echo "a gas at density 0.3 with e = 0.5 cools and gathers into clusters (slow, blue);";;
         cluster) echo "two discs meet at v = (±0.8, 0) and scatter, mostly across the line of flight;";;
@@ -144,6 +152,10 @@ if [ "$docs" -eq 1 ]; then
         smoke-flow) echo "the smoke as buoyancy plus drag towards the air's flow, 1,200 steps. The air is a vortex fed through its core (the vortex's flow plus an inflow of the same profile, set per cell in the wind plane), so its streamlines spiral in: the plume rises at its terminal speed (slow colours, no clamp), winds up round the vortex's right side and over it into the core, and gathers there (22 % of the particles within 1.5 core radii at the end, against 1 % when the flow is the vortex's alone and the plume passes its side). Its density, in bins of 8 × 8 cells, is drawn as grey haze under the particles.";;
         smoke-ids) echo "buoyant smoke in a breeze (the figures of docs/model.md, Units: buoyancy 0.0069, drag 0.033 towards a wind of 0.25 cells per step, a lifetime of 240 steps), periodic across, with ids and ages (M6b). After every step \`mpca_world_export_particles\` writes positions, ids and ages in one pass; the renderer sorts the particles by id and merges them with the last step's, and draws four frames a step, each particle sliding from its old cell to its new one (a new one appears where it is; one that wraps round the periodic edge jumps), as a soft puff that cools from yellow to violet and fades out with its age. The sheet is at whole steps; the GIF is the run's last frames, four a step (t=358.25 is a quarter of the way from step 358 to 359).";;
         water-pool) echo "a block of 9,216 particles released above the sphere under gravity 0.002, e = 0.5 and contacts on: it splashes off the sphere and, by step 1,000, lies as a pool on the floor (mean speed 0.07, no clamp), where the paper's rules (e = 1, no contacts) keep it bouncing round the box.";;
+        wake) l="$logs/wake.log"
+            echo "a disc body (radius 6 cells, e = 0.5) moved across at 0.4 cells per step through smoke that rises with the air at 0.15 cells per step (drag 0.05 towards it, a density of 0.3 kept by a vent along the ground, periodic across). Before every step \`mpca_world_move_body\` puts the disc a step further on; the smoke it takes is pushed out ahead of it and the smoke it meets bounces off it, and the channel it leaves rises with the smoke: over the crossing the 8 cells behind the disc held $(field "$l" 'wake: ' behind) particles a cell against $(field "$l" 'wake: ' ahead) in the same rows ahead of it, and the disc handed the smoke $(field "$l" 'wake: ' momentum_per_step) (mass × cells per step) a step, from $(field "$l" 'wake: ' reflected) reflections and $(field "$l" 'wake: ' pushed) push-outs ($(field "$l" 'wake: ' crushed) particles crushed). The haze is the density in bins of 8 × 8 cells.";;
+        box2d-wheel) l="$logs/box2d-wheel.log"
+            echo "C++ (\`c_examples/box2d_wheel.cpp\`, Box2D 2.4 from Debian's \`libbox2d-dev\`): a Box2D wheel (six blades, radius 1.2 m, on a pin whose friction holds back 100 N m) under a waterfall of 3 particles a step at cells of 5 cm and 120 steps a second (two a Box2D step at 60 Hz; a particle is 1 kg). Each blade is a capsule body moved from Box2D's pose before every step; the water's momentum on it, negated, is an impulse at the blade's middle. It turns the wheel clockwise (the program prints clockwise speeds and torques as negative): $(unsign "$(field "$l" 'wheel: t=1s' rpm)") turns a minute after 1 s and $(unsign "$(field "$l" 'wheel: t=5s' rpm)") after 5 s, against $(unsign "$(field "$l" 'wheel: t=5s' dry_rpm)") for the same wheel in a Box2D world without the water; over the last second the water's torque averaged $(unsign "$(field "$l" 'water: ' torque)") N m, against the pin's load of 100. The section on bodies below says why a waterfall and not a pool.";;
     esac; }
     # 12345 -> 12,345
     commas() { echo "$1" | sed ':a;s/\B[0-9]\{3\}\>/,&/;ta'; }
@@ -172,9 +184,9 @@ if [ "$docs" -eq 1 ]; then
         echo '```'
         echo
         echo "It installs what is missing (\`make\`, \`libosmesa6-dev\`, \`libpng-dev\`,"
-        echo "\`libgif-dev\`, with \`apt-get\` as root or through \`sudo\`), builds \`libmpca\` in release"
+        echo "\`libgif-dev\`, \`libbox2d-dev\`, with \`apt-get\` as root or through \`sudo\`), builds \`libmpca\` in release"
         echo "mode and the programs with \`make\`, runs the four scenes at full size (and"
-        echo "the smoke scene a second time, for 480 steps, and with flow drag, and the water poured into a pool; and smoke drawn between steps by id) and prints where the images"
+        echo "the smoke scene a second time, for 480 steps, and with flow drag, and the water poured into a pool; and smoke drawn between steps by id; and two scenes of moving bodies, one of them coupled with Box2D) and prints where the images"
         echo "are: \`out/scenes/\`. Each program also runs alone, e.g."
         echo "\`target/c_examples/water --size 32 --steps 200 --every 20 --out /tmp/w\`;"
         echo "\`--help\` lists its options (\`--size --steps --seed --every --tiles --px --out --name --threads --density --gif --png-level --progress --quiet --version\`);"
@@ -191,7 +203,8 @@ if [ "$docs" -eq 1 ]; then
             echo
         done
         echo "Simulation time only (\`mpca_world_step\`; building the world, drawing and"
-        echo "writing PNGs not included), one run each, on $machine,"
+        echo "writing PNGs not included; for wake and box2d-wheel, moving the bodies and reading"
+        echo "what they gave included, and for wake measuring its wake, but not Box2D's step), one run each, on $machine,"
         echo "beside the paper's time on a Sun SPARCstation 2GS:"
         echo
         echo "| scene | cells | particles (end) | steps | this library, per step | this library, total | paper (SPARCstation 2GS) | paper / this |"
@@ -210,7 +223,9 @@ if [ "$docs" -eq 1 ]; then
         echo "The scenes are those of \`tests/src/scenes.rs\` (sizes, seeds, boundaries,"
         echo "forces, emitters, obstacles, step counts): \`cargo test\` runs each C program"
         echo "for a few steps at full size and checks that its world hashes equal to the"
-        echo "Rust scene's, and runs each at a small size and checks its images."
+        echo "Rust scene's, and runs each at a small size and checks its images"
+        echo "(wake and box2d-wheel, which have no Rust twin, only the latter, with their"
+        echo "own figures: the clear strip behind the disc, the wheel the water turns)."
     } > "$logs/section.md"
     # Splice the section into README.md between its markers.
     awk -v section="$logs/section.md" '

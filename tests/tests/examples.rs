@@ -30,7 +30,7 @@ use clib::{library, root};
 use mpca_tests::scenes::{Scene, build, paper_scenes};
 
 /// What to install when the headers are missing (Debian, Ubuntu).
-const INSTALL: &str = "apt-get install -y libosmesa6-dev libpng-dev libgif-dev";
+const INSTALL: &str = "apt-get install -y libosmesa6-dev libpng-dev libgif-dev libbox2d-dev";
 
 /// The C compiler cc picks for this target, or its C++ compiler (for
 /// cpp_example.cpp).
@@ -64,6 +64,17 @@ fn check_build_dependencies(cc: &cc::Tool, dir: &Path) {
         out.status.success(),
         "the C examples need the OSMesa, libpng and giflib headers, which {} cannot find: {INSTALL}\n{}",
         cc.path().display(),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // Box2D (box2d-wheel) is C++ only.
+    let cxx = compiler(true);
+    let probe = dir.join("probe.cpp");
+    std::fs::write(&probe, "#include <box2d/box2d.h>\nint main() { return 0; }\n").expect("write the probe");
+    let out = cxx.to_command().arg("-fsyntax-only").arg(&probe).output().expect("the C++ compiler runs");
+    assert!(
+        out.status.success(),
+        "box2d-wheel needs Box2D 2.4's headers, which {} cannot find: {INSTALL}\n{}",
+        cxx.path().display(),
         String::from_utf8_lossy(&out.stderr)
     );
 }
@@ -410,6 +421,88 @@ fn smoke_ids_follows_every_particle_by_id_and_draws_between_steps() {
     assert!(g.coloured > 0, "{gif_line}");
 }
 
+/// A small run of a 2D scene whose fixed parts (bodies, walls, haze) are
+/// all grey: every frame, tile and the GIF's last frame hold exactly
+/// `particles * point_px^2` coloured pixels (no two particles share a cell,
+/// and bodies are drawn under them), and the sheet and the GIF have the
+/// sizes printed. Returns the program's stdout.
+fn check_body_scene(scene: &str, args: &[&str]) -> String {
+    let out_dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("examples").join(scene);
+    let _ = std::fs::remove_dir_all(&out_dir);
+    let out_s = out_dir.to_string_lossy().into_owned();
+    let mut all = args.to_vec();
+    all.extend(["--tiles", "3", "--gif", "10", "--px", "256", "--out", &out_s]);
+    let stdout = run(scene, &all);
+    println!("{stdout}");
+    let frames: Vec<Drawn> = stdout.lines().filter(|l| l.starts_with("frame: ")).map(drawn).collect();
+    let tiles: Vec<Drawn> = stdout.lines().filter(|l| l.starts_with("tile: ")).map(drawn).collect();
+    assert!(frames.len() >= 2 && tiles.len() == 3, "{scene}: frames and tiles");
+    for (i, d) in frames.iter().enumerate() {
+        let path = d.path.as_ref().unwrap();
+        assert_eq!(path, &out_dir.join(format!("{scene}-frame-{i:04}.png")), "frames numbered in order");
+        let p = pngstat(path);
+        assert_eq!((p.width, p.height), (d.width, d.height), "{}: dimensions", path.display());
+        let (lo, hi) = particle_pixels(d);
+        assert!((lo..=hi).contains(&p.coloured), "{}: {} particle pixels, expected {lo}", path.display(), p.coloured);
+        assert!(p.nonbg > p.coloured, "{}: no body or wall drawn", path.display());
+    }
+    let sheet_line = stdout.lines().find(|l| l.starts_with("sheet: ")).expect("a sheet: line");
+    let sheet = pngstat(&out_dir.join(format!("{scene}-sheet.png")));
+    assert_eq!((sheet.width, sheet.height), dims(&fields(sheet_line), sheet_line));
+    let (lo, hi) = tiles.iter().map(particle_pixels).fold((0, 0), |(a, b), (l, h)| (a + l, b + h));
+    assert!((lo..=hi).contains(&sheet.coloured), "{sheet_line}: {} particle pixels, expected {lo}", sheet.coloured);
+    let gif_line = stdout.lines().find(|l| l.starts_with("gif: ")).expect("a gif: line");
+    let g = pngstat(&out_dir.join(format!("{scene}.gif")));
+    assert_eq!(g.frames, Some(10), "{gif_line}");
+    assert_eq!((g.width, g.height), dims(&fields(gif_line), gif_line));
+    let (lo, hi) = particle_pixels(&tiles[2]);
+    assert!((lo..=hi).contains(&g.coloured), "{gif_line}: last frame: {} particle pixels, expected {lo}", g.coloured);
+    stdout
+}
+
+/// `wake` (M13): a disc body moved through rising smoke every step. The
+/// strip just behind the disc holds less smoke than the same rows ahead of
+/// it, the disc pushed and reflected smoke and handed it momentum along its
+/// motion (+x), and the world is the same on threads (the moves are calls
+/// between steps, the step the parallel one).
+#[test]
+fn wake_moves_a_disc_through_smoke_and_leaves_a_clear_strip_behind_it() {
+    let stdout = check_body_scene("wake", &["--size", "32", "--steps", "60", "--every", "30"]);
+    let line = stdout.lines().find(|l| l.starts_with("wake: ")).expect("a wake: line");
+    let f = fields(line);
+    let (behind, ahead): (f64, f64) = (number(&f, "behind", line), number(&f, "ahead", line));
+    assert!(behind < ahead, "{line}");
+    assert!(number::<u64>(&f, "pushed", line) > 0 && number::<u64>(&f, "reflected", line) > 0, "{line}");
+    let momentum = f["momentum_per_step"].trim_matches(|c| c == '(' || c == ')');
+    let x: f64 = momentum.split(',').next().unwrap().parse().expect("a number");
+    assert!(x > 0.0, "the disc moves right and pushes the smoke right: {line}");
+    let end = |stdout: &str| stdout.lines().find(|l| l.starts_with("end: ")).expect("an end: line").to_string();
+    let out_dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("examples").join("wake-threads");
+    let out_s = out_dir.to_string_lossy().into_owned();
+    let args = ["--size", "32", "--steps", "60", "--every", "0", "--tiles", "1", "--gif", "0", "--out", &out_s];
+    let serial = run("wake", &args);
+    let mut threaded = args.to_vec();
+    threaded.extend(["--threads", "2"]);
+    assert_eq!(end(&serial), end(&run("wake", &threaded)), "serial and 2 threads");
+    assert_eq!(end(&serial), end(&stdout), "drawing changes nothing");
+}
+
+/// `box2d-wheel` (M13 with Box2D): the falling water turns the Box2D wheel
+/// through the impulses its blades' momentum gives, so after a second it
+/// turns clockwise (negative), while its twin in a Box2D world without the
+/// water stands still.
+#[test]
+fn box2d_wheel_is_turned_by_the_water_and_its_dry_twin_is_not() {
+    let stdout = check_body_scene("box2d-wheel", &["--size", "32", "--steps", "120", "--every", "60"]);
+    let line = stdout.lines().find(|l| l.starts_with("wheel: t=1s")).expect("a wheel: line at 1 s");
+    let f = fields(line);
+    let (wet, dry): (f64, f64) = (number(&f, "rpm", line), number(&f, "dry_rpm", line));
+    assert!(wet < -1.0, "the water turns the wheel clockwise: {line}");
+    assert_eq!(dry.abs(), 0.0, "nothing turns the dry wheel: {line}");
+    let water = stdout.lines().find(|l| l.starts_with("water: ")).expect("a water: line");
+    assert!(number::<u64>(&fields(water), "reflected", water) > 0, "{water}");
+}
+
 /// Progress: `--progress` reports on stderr at each tenth of the steps, in
 /// order, up to 100 %; `--quiet`, and the default when stderr is not a
 /// terminal (as here), say nothing. The world ends the same either way,
@@ -526,7 +619,7 @@ fn the_c_scenes_are_the_rust_scenes() {
 
 #[test]
 fn every_program_documents_and_checks_its_options() {
-    for scene in ["aggregation", "cluster", "smoke", "water"] {
+    for scene in ["aggregation", "cluster", "smoke", "water", "wake", "box2d-wheel"] {
         let help = run(scene, &["--help"]);
         for option in
             ["--size N", "--steps N", "--seed N", "--every N", "--tiles N", "--px N", "--out DIR", "--name S", "--threads N", "--density N", "--png-level N", "--gif N", "--progress", "--quiet", "--version"]
@@ -562,7 +655,7 @@ fn the_threads_example_equals_the_serial_step() {
 #[test]
 fn every_example_program_prints_its_version() {
     let expected = env!("CARGO_PKG_VERSION"); // the workspace's, as mpca-ffi's
-    for program in ["aggregation", "cluster", "smoke", "water", "smoke-ids", "threads", "cpp_example"] {
+    for program in ["aggregation", "cluster", "smoke", "water", "smoke-ids", "wake", "box2d-wheel", "threads", "cpp_example"] {
         let out = run(program, &["--version"]);
         assert_eq!(out, format!("{program} (libmpca {expected})\n"), "{program} --version");
     }
