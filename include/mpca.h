@@ -639,66 +639,6 @@ typedef uint32_t mpca_shape_kind;
 typedef struct mpca_world mpca_world;
 
 /**
- * An obstacle shape (M7) as one value: to ask what it takes
- * (mpca_desc_surface_entries, mpca_world_surface_entries) and to add it
- * (mpca_world_add_shape). Set `struct_size` to `sizeof(mpca_shape)`.
- */
-typedef struct mpca_shape {
-  /**
-   * `sizeof(mpca_shape)`.
-   */
-  uint32_t struct_size;
-  /**
-   * An `mpca_shape_kind`.
-   */
-  uint32_t kind;
-  /**
-   * A point on the plane (half-space), the lower corner (box), the
-   * centre (disc, sphere), one end (capsule).
-   */
-  float a[3];
-  /**
-   * The outward normal (half-space), the upper corner (box), the other
-   * end (capsule); not read for a disc or a sphere.
-   */
-  float b[3];
-  /**
-   * The radius (disc, sphere, capsule); not read for the others.
-   */
-  float radius;
-} mpca_shape;
-
-/**
- * What a body gave the particles in the last step (M13). Set
- * `struct_size` to `sizeof(mpca_body_stats)`.
- */
-typedef struct mpca_body_stats {
-  /**
-   * `sizeof(mpca_body_stats)`, set by the caller.
-   */
-  uint32_t struct_size;
-  /**
-   * Particles reflected off the body's cells in the last step.
-   */
-  uint32_t reflected;
-  /**
-   * Particles pushed out of cells the body took, by the moves before
-   * the last step.
-   */
-  uint32_t pushed;
-  /**
-   * Particles those moves removed for want of a free cell near the body.
-   */
-  uint32_t crushed;
-  /**
-   * The momentum the body gave the particles, `sum m (v' - v)`, in the
-   * world's mass times cells per step: push a rigid body back by minus
-   * this.
-   */
-  double momentum[3];
-} mpca_body_stats;
-
-/**
  * A scene description. Fill it with mpca_desc_defaults, then change the
  * fields the scene needs. Flags are 0 or 1.
  */
@@ -851,6 +791,66 @@ typedef struct mpca_desc {
    */
   uint32_t body_surface_capacity;
 } mpca_desc;
+
+/**
+ * An obstacle shape (M7) as one value: to ask what it takes
+ * (mpca_desc_surface_entries, mpca_world_surface_entries) and to add it
+ * (mpca_world_add_shape). Set `struct_size` to `sizeof(mpca_shape)`.
+ */
+typedef struct mpca_shape {
+  /**
+   * `sizeof(mpca_shape)`.
+   */
+  uint32_t struct_size;
+  /**
+   * An `mpca_shape_kind`.
+   */
+  uint32_t kind;
+  /**
+   * A point on the plane (half-space), the lower corner (box), the
+   * centre (disc, sphere), one end (capsule).
+   */
+  float a[3];
+  /**
+   * The outward normal (half-space), the upper corner (box), the other
+   * end (capsule); not read for a disc or a sphere.
+   */
+  float b[3];
+  /**
+   * The radius (disc, sphere, capsule); not read for the others.
+   */
+  float radius;
+} mpca_shape;
+
+/**
+ * What a body gave the particles in the last step (M13). Set
+ * `struct_size` to `sizeof(mpca_body_stats)`.
+ */
+typedef struct mpca_body_stats {
+  /**
+   * `sizeof(mpca_body_stats)`, set by the caller.
+   */
+  uint32_t struct_size;
+  /**
+   * Particles reflected off the body's cells in the last step.
+   */
+  uint32_t reflected;
+  /**
+   * Particles pushed out of cells the body took, by the moves before
+   * the last step.
+   */
+  uint32_t pushed;
+  /**
+   * Particles those moves removed for want of a free cell near the body.
+   */
+  uint32_t crushed;
+  /**
+   * The momentum the body gave the particles, `sum m (v' - v)`, in the
+   * world's mass times cells per step: push a rigid body back by minus
+   * this.
+   */
+  double momentum[3];
+} mpca_body_stats;
 
 /**
  * An emitter. Set `struct_size` to `sizeof(mpca_emitter)`.
@@ -1115,6 +1115,19 @@ const char *mpca_version(void);
  */
 mpca_status mpca_debug_panic(void);
 #endif
+
+/**
+ * The body surface entries a body of `shape` takes alone, where it lies,
+ * in a world of `desc`, into `out_entries`: what `body_surface_capacity`
+ * must hold for it. Bodies together need at most the sum of theirs; the
+ * same shape elsewhere may take a few more or fewer, as its cells fall on
+ * the grid. Refused as mpca_world_bytes would refuse the description and
+ * mpca_world_add_body the shape; MPCA_STATUS_NOT_ENABLED without
+ * `obstacles` and `body_capacity`.
+ */
+mpca_status mpca_desc_body_surface_entries(const struct mpca_desc *desc,
+                                           const struct mpca_shape *shape,
+                                           uint32_t *out_entries);
 
 /**
  * Adds a body of `shape` moving at `velocity` (3 values, cells per step,

@@ -110,6 +110,16 @@ inline mpca_desc desc_from_image(const void *image, std::size_t len) {
     return d;
 }
 
+/** The body surface entries a body of `shape` takes alone where it lies,
+ * in a world of `desc` (mpca_desc_body_surface_entries); sets the shape's
+ * struct_size. */
+inline std::uint32_t body_surface_entries(const mpca_desc &desc, mpca_shape shape) {
+    shape.struct_size = sizeof shape;
+    std::uint32_t entries = 0;
+    check(mpca_desc_body_surface_entries(&desc, &shape, &entries));
+    return entries;
+}
+
 /** An obstacle surface cell: its outward normal and restitution. */
 struct surface {
     vec3 normal;

@@ -4,6 +4,7 @@
 //! library built without obstacles has no world with bodies: its calls
 //! check their arguments and return MPCA_STATUS_NOT_ENABLED.
 
+use crate::desc::mpca_desc;
 use crate::obstacles::mpca_shape;
 use crate::{check_size, guard, mpca_status, mpca_world};
 
@@ -25,6 +26,29 @@ pub struct mpca_body_stats {
     /// world's mass times cells per step: push a rigid body back by minus
     /// this.
     pub momentum: [f64; 3],
+}
+
+/// The body surface entries a body of `shape` takes alone, where it lies,
+/// in a world of `desc`, into `out_entries`: what `body_surface_capacity`
+/// must hold for it. Bodies together need at most the sum of theirs; the
+/// same shape elsewhere may take a few more or fewer, as its cells fall on
+/// the grid. Refused as mpca_world_bytes would refuse the description and
+/// mpca_world_add_body the shape; MPCA_STATUS_NOT_ENABLED without
+/// `obstacles` and `body_capacity`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mpca_desc_body_surface_entries(desc: *const mpca_desc, shape: *const mpca_shape, out_entries: *mut u32) -> mpca_status {
+    guard(|c| {
+        let d = c.get(desc)?.to_core();
+        let d = d.as_ref().map_err(|&s| s)?;
+        let shape = c.get(shape)?.to_core()?;
+        let out = c.out(out_entries)?;
+        #[cfg(feature = "obstacles")]
+        out.set(d.body_surface_entries(shape)?);
+        #[cfg(not(feature = "obstacles"))]
+        return Err(crate::status::disabled((d, shape, out)));
+        #[cfg(feature = "obstacles")]
+        Ok(())
+    })
 }
 
 /// Adds a body of `shape` moving at `velocity` (3 values, cells per step,

@@ -39,6 +39,7 @@ static const struct symbol {
     SYMBOL(mpca_world_bytes),
     SYMBOL(mpca_world_add_emitter),
     SYMBOL(mpca_world_add_body),
+    SYMBOL(mpca_desc_body_surface_entries),
     SYMBOL(mpca_world_move_body),
     SYMBOL(mpca_world_remove_body),
     SYMBOL(mpca_world_body_stats),

@@ -333,6 +333,7 @@ static void same_as_c() {
     paddle.b[0] = 5.5f;
     paddle.b[1] = 8.0f;
     paddle.radius = 0.6f;
+    CHECK(mpca::body_surface_entries(db, paddle) > 0);
     const std::uint32_t id = b.add_body(paddle, {0.5f, 0.0f, 0.0f}, 1.0f);
     CHECK(b.cell({5, 5, 0}).kind == MPCA_CELL_KIND_OBSTACLE && b.particle_count() == 1);
     b.step(1);
@@ -636,6 +637,7 @@ static void every_function() {
     WRAPS(mpca_world_set_emitter_rate, &W::set_emitter_rate);
     WRAPS(mpca_world_emitter_stats, &W::emitter_stats);
     WRAPS(mpca_world_add_body, &W::add_body);
+    WRAPS(mpca_desc_body_surface_entries, &mpca::body_surface_entries);
     WRAPS(mpca_world_move_body, &W::move_body);
     WRAPS(mpca_world_remove_body, &W::remove_body);
     WRAPS(mpca_world_body_stats, &W::body_stats);

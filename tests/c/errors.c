@@ -1095,6 +1095,11 @@ static void body_cases(void) {
     disc.a[0] = 6.0f;
     disc.a[1] = 6.5f;
     disc.radius = 0.9f;
+    /* Its entries, known before: the description's count is what the
+     * body takes (the table has room for it). */
+    uint32_t entries = SENTINEL_U32;
+    CHECK_OK(mpca_desc_body_surface_entries(&d, &disc, &entries));
+    CHECK(entries > 0 && entries <= d.body_surface_capacity);
     uint32_t id = SENTINEL_U32;
     CHECK_OK(mpca_world_add_body(w, &disc, u, 0.5f, &id));
     CHECK(id == 0);
@@ -1154,6 +1159,18 @@ static void body_cases(void) {
     REFUSED(MPCA_STATUS_BAD_STRUCT_SIZE, mpca_world_body_stats(w, id, &b));
     b.struct_size = sizeof b;
     REFUSED(MPCA_STATUS_NOT_ENABLED, mpca_world_add_body(full2, &disc, u, 1.0f, &out));
+    mpca_desc no_bodies = d;
+    no_bodies.body_capacity = 0;
+    REFUSED(MPCA_STATUS_NOT_ENABLED, mpca_desc_body_surface_entries(&no_bodies, &disc, &out));
+    REFUSED(MPCA_STATUS_NULL_POINTER, mpca_desc_body_surface_entries(NULL, &disc, &out));
+    REFUSED(MPCA_STATUS_NULL_POINTER, mpca_desc_body_surface_entries(&d, NULL, &out));
+    REFUSED(MPCA_STATUS_NULL_POINTER, mpca_desc_body_surface_entries(&d, &disc, NULL));
+    bad = disc;
+    bad.kind = 5;
+    REFUSED(MPCA_STATUS_BAD_ENUM, mpca_desc_body_surface_entries(&d, &bad, &out));
+    bad = disc;
+    bad.radius = -1.0f;
+    REFUSED(MPCA_STATUS_BAD_SHAPE, mpca_desc_body_surface_entries(&d, &bad, &out));
     REFUSED(MPCA_STATUS_NOT_ENABLED, mpca_world_body_stats(full2, 0, &b));
     CHECK(out == SENTINEL_U32);
     disc.a[0] = 20.0f;

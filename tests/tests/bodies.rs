@@ -447,3 +447,45 @@ fn an_image_keeps_the_bodies_and_the_world_steps_on_as_before() {
     let p = World::init(&plain, &mut mem).unwrap();
     assert_eq!(u32::from_le_bytes(image(p)[8..12].try_into().unwrap()), 2);
 }
+
+#[test]
+fn the_body_surface_entries_a_shape_takes_are_known_before_it_is_added() {
+    // Expect: for random discs, boxes and capsules in a 2D world and
+    // spheres and capsules in a 3D one, with walls and open faces, the
+    // description's count for the shape is exactly what a body of it
+    // takes in a fresh world: a table of that size takes it, one fewer
+    // refuses it (SurfaceTableFull). Two bodies together take at most the
+    // sum of their counts.
+    let mut rng = SetupRng::new(4242);
+    for dim in [2u32, 3] {
+        let mut d = if dim == 2 { Description::new_2d(40, 30) } else { Description::new_3d(20, 16, 12) };
+        d.boundary[0] = [Boundary::Wall; 2];
+        d.boundary[1] = [Boundary::Open; 2];
+        let n = d.size.map(|s| s as f32);
+        for case in 0..40 {
+            let c = [0, 1, 2].map(|k| if k < dim as usize { rng.unit() * n[k] } else { 0.5 });
+            let (s1, s2) = (shape(&mut rng, dim, c), shape(&mut rng, dim, [0, 1, 2].map(|k| c[k] + 2.0)));
+            let counts = [s1, s2].map(|s| with_bodies(d, 2, 1).body_surface_entries(s).unwrap());
+            for (s, count) in [(s1, counts[0]), (s2, counts[1])] {
+                for room in [count, count.saturating_sub(1)] {
+                    let desc = with_bodies(d, 2, room);
+                    let mut mem = memory(&desc);
+                    let w = World::init(&desc, &mut mem).unwrap();
+                    let r = w.add_body(s, [0.0; 3], 1.0);
+                    if room == count {
+                        assert_eq!(r, Ok(0), "{dim}D case {case}: {s:?} in {room}");
+                    } else if count > 0 {
+                        assert_eq!(r, Err(Error::SurfaceTableFull), "{dim}D case {case}: {s:?} in {room}");
+                    }
+                }
+            }
+            let desc = with_bodies(d, 2, counts[0] + counts[1]);
+            let mut mem = memory(&desc);
+            let w = World::init(&desc, &mut mem).unwrap();
+            w.add_body(s1, [0.0; 3], 1.0).unwrap();
+            w.add_body(s2, [0.0; 3], 1.0).unwrap();
+        }
+    }
+    let plain = Description::new_2d(8, 8);
+    assert_eq!(plain.body_surface_entries(Shape::Disc { centre: [4.0, 4.0], radius: 2.0 }), Err(Error::NotEnabled));
+}

@@ -118,6 +118,30 @@ impl Draw<'_> {
     }
 }
 
+impl crate::Description {
+    /// The body surface entries (M13) a body of `shape` takes alone, where
+    /// the shape lies, in a world of this description: what
+    /// `body_surface_capacity` must hold for it. Bodies together need at
+    /// most the sum of theirs (a cell with a free neighbour among them has
+    /// one alone too), and static obstacles only take entries away; the
+    /// same shape elsewhere may take a few more or fewer, as its cells fall
+    /// on the grid.
+    ///
+    /// Refused as the world would refuse the description or the shape
+    /// (`add_body`); `NotEnabled` for a description without bodies.
+    pub fn body_surface_entries(&self, shape: Shape) -> Result<u32, Error> {
+        let l = self.plan()?;
+        if !self.has_bodies() {
+            return Err(Error::NotEnabled);
+        }
+        let dim = self.dim as usize;
+        let body = Body::new(shape, [0.0; 3], 1.0, dim)?;
+        let frame = Frame { n: l.n, boundary: self.boundary, dim };
+        // At most the world's cell count, which a u32 holds (`Layout::of`).
+        Ok(Draw { frame, count: 1, body: &|_| body, is_static: &|_| false }.entries() as u32)
+    }
+}
+
 impl World {
     /// The body table's head and slots; `NotEnabled` in a world without
     /// bodies (M13: `obstacles` and a `body_capacity`).
