@@ -1059,7 +1059,7 @@ impl World {
     /// This world must have the image's plan of memory: the same sizes,
     /// velocity width and parts (obstacles, per-particle masses, lifetimes,
     /// force field, potential, wind plane) and the same capacities (mass classes,
-    /// surface and emitter tables); anything else is refused with
+    /// surface, emitter, body and body surface tables); anything else is refused with
     /// `ImageMismatch`. What does not change the plan (seed, forces,
     /// restitutions, method, faces...) is taken from the image. A world built
     /// from [`image_description`] always fits.
