@@ -23,7 +23,7 @@ use crate::rules::vector::{dot, normalise};
 use crate::api::obstacles::{Frame, Mask};
 use crate::step::clamp::clamp_counted;
 use crate::storage::cells::Cells;
-use crate::storage::layout::{head_and_bodies, mark, put_bit, store, view_ref, Site};
+use crate::storage::layout::{head_and_bodies, mark, put_bit, store, stored, view_ref, Site};
 use crate::storage::world::World;
 
 /// What a body gave the particles in the last step (M13): reflections off
@@ -185,7 +185,7 @@ impl World {
     /// Removes body `id`: its cells are free again (M13).
     pub fn remove_body(&mut self, id: u32) -> Result<(), Error> {
         self.body(id)?;
-        self.redraw(Change { slot: id as usize, body: Body::default() })
+        self.redraw(Change { slot: id as usize, body: Body::ZERO })
     }
 
     /// The crushed count and the redraws since the last step, for an image
@@ -383,7 +383,7 @@ impl World {
         for ring in 1..=2 {
             // The first free cell in that order: the free one that orders
             // first, found in one pass.
-            let mut best: Option<(f32, i32, usize)> = None;
+            let mut best: Option<(f32, i32, Site)> = None;
             for_ring(frame.dim, ring, &mut |d| {
                 let key = dot(d.map(|v| v as f32), n);
                 let Beyond::Inside(p) = frame.beyond(c, d) else { return };
@@ -391,23 +391,17 @@ impl World {
                 if key < 0.0 || self.is_obstacle(s) || self.occupied(s) {
                     return;
                 }
-                let this = (key, d.iter().map(|v| v * v).sum(), s.cell);
-                let first = |b: (f32, i32, usize)| this.0 > b.0 || (this.0 == b.0 && (this.1, this.2) < (b.1, b.2));
+                let this = (key, d.iter().map(|v| v * v).sum(), s);
+                let first = |b: (f32, i32, Site)| this.0 > b.0 || (this.0 == b.0 && (this.1, this.2.cell) < (b.1, b.2.cell));
                 if best.is_none_or(first) {
                     best = Some(this);
                 }
             });
-            if let Some((_, _, cell)) = best {
-                return Some(self.site_of(cell));
+            if let Some((_, _, s)) = best {
+                return Some(s);
             }
         }
         None
-    }
-
-    /// The site of dense cell index `cell`.
-    fn site_of(&self, cell: usize) -> Site {
-        let n = self.layout().n;
-        self.layout().site(cell % n[0], cell / n[0] % n[1], cell / (n[0] * n[1]))
     }
 
     /// Moves the particle at `from` to `to` with M13's velocity for a body
@@ -435,10 +429,9 @@ impl World {
         let width = with_quant!(self.head.desc.quantization, Q => Width::of::<Q>());
         let bytes = if width.wide() { 2 } else { 1 };
         let (head, p) = self.planes::<u8>();
-        let read = |plane: &[u8], i: usize| if bytes == 2 { i32::from(i16::from_ne_bytes([plane[2 * i], plane[2 * i + 1]])) } else { i32::from(plane[i] as i8) };
         let mut v = [0i32; 3];
         for k in 0..dim {
-            v[k] = read(p.velocity, from.cell * dim + k) << width.fine;
+            v[k] = stored(p.velocity, from.cell * dim + k, bytes) << width.fine;
         }
         let mut x = pushed_velocity(v, b.fine, n);
         clamp_counted::<3>(&mut x, width.unit, &class, &mut head.counters);
@@ -501,7 +494,7 @@ impl World {
         let used = head.surfaces as usize;
         for (e, t) in p.body_surface[..used].iter().zip(p.body_tally[..used].iter_mut()) {
             if let Some(b) = table.get_mut(e.body as usize) {
-                b.current.add(&Tally { momentum: t.momentum, reflected: t.reflected, ..Tally::default() });
+                b.current.add(t);
             }
             *t = Default::default();
         }

@@ -19,6 +19,7 @@ use crate::rules::obstacle::{normal_q30, Surface};
 use crate::rules::quant::unit_of;
 use crate::step::convert_class;
 use crate::step::partition::Partition;
+use crate::storage::layout::stored;
 use crate::storage::world::{Counters, World};
 
 /// The integers one step of a world reads, converted from its description
@@ -378,7 +379,7 @@ impl World {
                 }
                 for k in 0..dim {
                     let at = cell * dim + k;
-                    let q = if wide { i32::from(i16::from_ne_bytes([velocity[2 * at], velocity[2 * at + 1]])) } else { i32::from(velocity[at] as i8) };
+                    let q = stored(velocity, at, if wide { 2 } else { 1 });
                     if q.abs() > limit {
                         return Err(Error::ImageInvalid);
                     }

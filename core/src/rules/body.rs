@@ -10,7 +10,11 @@ use crate::rules::fixed::sat;
 /// What a body exchanged with the particles: momentum in the body's
 /// integers (M13: each particle's relative mass, 24 bits, times its change
 /// of velocity in fine units, summed wrapping), and counts. A body keeps
-/// the tally of the step under way and the last finished one.
+/// the tally of the step under way and the last finished one. The step
+/// also keeps one per body surface entry, which one block at most touches
+/// in a step (a particle asks only for cells of its own block), so blocks
+/// on any thread add to them without atomics; the step's end gathers them
+/// into their bodies.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 #[repr(C)]
 pub(crate) struct Tally {
@@ -41,19 +45,6 @@ impl Tally {
         self.pushed = self.pushed.wrapping_add(o.pushed);
         self.crushed = self.crushed.wrapping_add(o.crushed);
     }
-}
-
-/// What a step's reflections off one body surface cell add up to: kept
-/// per entry of the body surface table, which one block at most touches
-/// in a step (a particle asks only for cells of its own block), so blocks
-/// on any thread add to them without atomics; the step's end gathers them
-/// into their bodies.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-#[repr(C)]
-pub(crate) struct CellTally {
-    pub momentum: [i64; 3],
-    pub reflected: u32,
-    pub spare: u32,
 }
 
 /// One body surface cell (M13): as a static [`Surface`](crate::rules::obstacle::Surface),

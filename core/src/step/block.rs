@@ -333,7 +333,7 @@ pub(crate) struct Shared<'a> {
 pub(crate) struct Moving<'a> {
     pub surface: &'a [crate::rules::body::BodySurface],
     pub table: &'a [crate::rules::body::Body],
-    pub tally: Cells<'a, crate::rules::body::CellTally>,
+    pub tally: Cells<'a, crate::rules::body::Tally>,
 }
 
 /// The planes a step writes. Copies go to the tasks of a parallel step,

@@ -8,7 +8,7 @@ use crate::rules::collision::WIDEST;
 use crate::rules::faces::{resolve, Beyond, Coords};
 use crate::rules::fixed::scaled;
 #[cfg(feature = "obstacles")]
-use crate::rules::body::{body_surface_at, CellTally, Tally};
+use crate::rules::body::body_surface_at;
 use crate::rules::fixed::sat;
 use crate::rules::obstacle::{axis_q30, dot_q30, normal_q30, reflect, surface_at, Surface};
 use crate::rules::class::Class;
@@ -149,10 +149,10 @@ pub(crate) fn reflect_off(sh: &Shared<'_>, mut x: [i32; 3], c: usize, to: Wanted
     // M13: what the body gave the particle, tallied in the entry's cell.
     #[cfg(feature = "obstacles")]
     if let Some((i, ..)) = moving {
-        let t = sh.bodies.tally.get(i);
-        let mut tally = Tally { momentum: t.momentum, reflected: t.reflected.wrapping_add(1), ..Tally::default() };
+        let mut tally = sh.bodies.tally.get(i);
+        tally.reflected = tally.reflected.wrapping_add(1);
         tally.add_change(class.relative, [0, 1, 2].map(|k| x[k] - v[k]));
-        sh.bodies.tally.set(i, CellTally { momentum: tally.momentum, reflected: tally.reflected, spare: 0 });
+        sh.bodies.tally.set(i, tally);
     }
     #[cfg(not(feature = "obstacles"))]
     let _ = v;

@@ -11,7 +11,7 @@ use crate::api::desc::{Checked, Description, Quantization};
 use crate::rules::emitter::Slot;
 use crate::rules::obstacle::Surface;
 #[cfg(feature = "obstacles")]
-use crate::rules::body::{Body, BodiesHead, BodySurface, CellTally};
+use crate::rules::body::{Body, BodiesHead, BodySurface, Tally};
 use crate::rules::class::Class;
 use crate::storage::cells::Cells;
 use crate::storage::plain::Plain;
@@ -33,7 +33,7 @@ unsafe impl Plain for Body {}
 unsafe impl Plain for BodiesHead {}
 // SAFETY: i64 and u32 fields, no padding, every bit pattern valid.
 #[cfg(feature = "obstacles")]
-unsafe impl Plain for CellTally {}
+unsafe impl Plain for Tally {}
 // SAFETY: f32, u32, f32, u32 and i64 fields in that order (`repr(C)`), no
 // padding, every bit pattern valid.
 unsafe impl Plain for Class {}
@@ -267,7 +267,7 @@ impl Layout {
         #[cfg(feature = "obstacles")]
         let body = if d.has_bodies() {
             let entries = d.body_surface_capacity as usize;
-            [bit_plane, mul(d.body_capacity as usize, size_of::<Body>())? + size_of::<BodiesHead>(), mul(entries, size_of::<BodySurface>())?, mul(entries, size_of::<CellTally>())?]
+            [bit_plane, mul(d.body_capacity as usize, size_of::<Body>())? + size_of::<BodiesHead>(), mul(entries, size_of::<BodySurface>())?, mul(entries, size_of::<Tally>())?]
         } else {
             [0; 4]
         };
@@ -397,7 +397,7 @@ pub(crate) struct Planes<'a, Q> {
     #[cfg(feature = "obstacles")]
     pub body_surface: &'a mut [BodySurface],
     #[cfg(feature = "obstacles")]
-    pub body_tally: &'a mut [CellTally],
+    pub body_tally: &'a mut [Tally],
 }
 
 /// The body table's plane split into its head and its slots (M13); an
@@ -434,6 +434,17 @@ pub(crate) fn store(plane: &mut [u8], i: usize, width: usize, q: i32) {
         plane[i] = q as i8 as u8;
     } else {
         plane[2 * i..2 * i + 2].copy_from_slice(&(q as i16).to_ne_bytes());
+    }
+}
+
+/// Stored component `i` of a velocity plane of `width`-byte components,
+/// viewed as bytes, in quanta: what [`store`] wrote.
+#[inline(always)]
+pub(crate) fn stored(plane: &[u8], i: usize, width: usize) -> i32 {
+    if width == 1 || !cfg!(feature = "q16") {
+        i32::from(plane[i] as i8)
+    } else {
+        i32::from(i16::from_ne_bytes([plane[2 * i], plane[2 * i + 1]]))
     }
 }
 
