@@ -790,6 +790,19 @@ typedef struct mpca_desc {
    * an upper bound for it.
    */
   uint32_t body_surface_capacity;
+  /**
+   * 1: a particle resting on a full support (walls, obstacles,
+   * particles at rest) loses its velocity into the support along the
+   * uniform force and takes no push from it (M5.7b), so a pool or a pile
+   * comes to rest exactly. 0: the paper's rules.
+   */
+  uint32_t rest;
+  /**
+   * Must be zero. It keeps the structure free of padding, whose bytes a
+   * copy need not keep, so that descriptions compare byte for byte; the
+   * next field takes its place.
+   */
+  uint32_t reserved;
 } mpca_desc;
 
 /**

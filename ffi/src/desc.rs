@@ -171,6 +171,15 @@ pub struct mpca_desc {
     /// neighbour takes one; mpca_desc_surface_entries of a body's shape is
     /// an upper bound for it.
     pub body_surface_capacity: u32,
+    /// 1: a particle resting on a full support (walls, obstacles,
+    /// particles at rest) loses its velocity into the support along the
+    /// uniform force and takes no push from it (M5.7b), so a pool or a pile
+    /// comes to rest exactly. 0: the paper's rules.
+    pub rest: u32,
+    /// Must be zero. It keeps the structure free of padding, whose bytes a
+    /// copy need not keep, so that descriptions compare byte for byte; the
+    /// next field takes its place.
+    pub reserved: u32,
 }
 
 /// Description::new_2d's defaults as C sees them (the sizes aside), built
@@ -223,7 +232,7 @@ impl mpca_desc {
             boundary,
             mass: d.mass,
             per_particle_mass: d.per_particle_mass as u32,
-            mass_classes: d.mass_classes,
+            mass_classes: d.mass_classes as u32,
             obstacles: d.obstacles as u32,
             surface_capacity: d.surface_capacity,
             forces: force_bit(f.uniform, mpca_force::Uniform)
@@ -252,6 +261,8 @@ impl mpca_desc {
             identity: d.identity.bits(),
             body_capacity: d.body_capacity,
             body_surface_capacity: d.body_surface_capacity,
+            rest: d.rest as u32,
+            reserved: 0,
         }
     }
 
@@ -283,10 +294,11 @@ impl mpca_desc {
         d.drift = if one(self.drift) { Drift::Calibrated } else { Drift::Paper };
         d.collisions = if one(self.collisions) { Collisions::SpeedLimited } else { Collisions::Paper };
         d.contacts = one(self.contacts);
+        d.rest = one(self.rest);
         d.energy_neutral = one(self.energy_neutral);
         d.drag = Drag { rate: self.drag_rate, wind: self.drag_wind, field: one(self.drag_wind_field), vortex: one(self.drag_vortex) };
         d.lifetimes = one(self.lifetimes);
-        if ones > 1 || self.forces & !FORCE_BITS != 0 || self.identity > Identity::ALL.bits() {
+        if ones > 1 || self.forces & !FORCE_BITS != 0 || self.identity > Identity::ALL.bits() || self.reserved != 0 {
             return Err(mpca_status::BadEnum);
         }
         // The core's flags are the C ABI's bits (checked at the top).
@@ -300,7 +312,8 @@ impl mpca_desc {
             }
         }
         d.mass = self.mass;
-        d.mass_classes = self.mass_classes;
+        // Beyond 16 bits: refused by the check (masses on) or ignored.
+        d.mass_classes = self.mass_classes.min(u32::from(u16::MAX)) as u16;
         d.surface_capacity = self.surface_capacity;
         (d.body_capacity, d.body_surface_capacity) = (self.body_capacity, self.body_surface_capacity);
         d.forces = Forces {

@@ -28,7 +28,7 @@ fn core_desc(c: &mpca_desc) -> Description {
     d.boundary = c.boundary.map(|a| a.map(|v| b[v as usize % 3]));
     d.mass = c.mass;
     d.per_particle_mass = c.per_particle_mass & 1 == 1;
-    d.mass_classes = c.mass_classes % 300;
+    d.mass_classes = (c.mass_classes % 300) as u16;
     d.obstacles = c.obstacles & 1 == 1;
     d.surface_capacity = c.surface_capacity % 100;
     d.body_capacity = c.body_capacity % 5;
@@ -51,6 +51,7 @@ fn core_desc(c: &mpca_desc) -> Description {
     d.lifetimes = c.lifetimes & 1 == 1;
     d.collisions = if c.collisions & 1 == 1 { Collisions::SpeedLimited } else { Collisions::Paper };
     d.contacts = c.contacts & 1 == 1;
+    d.rest = c.rest & 1 == 1;
     d.energy_neutral = c.energy_neutral & 1 == 1;
     d.drag.rate = c.drag_rate;
     d.drag.wind = c.drag_wind;
@@ -68,7 +69,7 @@ fn to_c(d: &Description) -> mpca_desc {
     c.boundary = d.boundary.map(|a| a.map(|b| b as u32));
     c.mass = d.mass;
     c.per_particle_mass = u32::from(d.per_particle_mass);
-    c.mass_classes = d.mass_classes;
+    c.mass_classes = u32::from(d.mass_classes);
     c.obstacles = u32::from(d.obstacles);
     c.surface_capacity = d.surface_capacity;
     c.body_capacity = d.body_capacity;
@@ -89,6 +90,7 @@ fn to_c(d: &Description) -> mpca_desc {
     c.lifetimes = u32::from(d.lifetimes);
     c.collisions = d.collisions as u32;
     c.contacts = u32::from(d.contacts);
+    c.rest = u32::from(d.rest);
     c.energy_neutral = u32::from(d.energy_neutral);
     c.drag_rate = d.drag.rate;
     c.drag_wind = d.drag.wind;

@@ -172,12 +172,13 @@ impl Gpu {
 
 /// Why this backend cannot run a description: `None` where it can.
 pub fn unsupported(d: &Description) -> Option<&'static str> {
-    let checks: [(bool, &'static str); 2] = [
+    let checks: [(bool, &'static str); 3] = [
         // Correct where loops are not limited, but a dense 3D block's search
         // (8! leaves) runs past the loop limit of Mesa's lavapipe, which
         // ends a shader's loops after 65,535 iterations in all: untested.
         (d.dim == 2 || d.method != Method::Exhaustive, "exhaustive assignment in 3D"),
         (!(d.obstacles && d.body_capacity > 0), "bodies, obstacles the caller moves (M13)"),
+        (!d.rest, "resting contact (M5.7b)"),
     ];
     checks.iter().find(|(ok, _)| !ok).map(|(_, what)| *what)
 }

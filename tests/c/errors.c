@@ -19,7 +19,7 @@
 #include "check.h"
 
 /* The layout ffi/src/lib.rs asserts on the Rust side. */
-STATIC_ASSERT(sizeof(mpca_desc) == 184 && ALIGNOF(mpca_desc) == 8, "mpca_desc layout");
+STATIC_ASSERT(sizeof(mpca_desc) == 192 && ALIGNOF(mpca_desc) == 8, "mpca_desc layout");
 STATIC_ASSERT(sizeof(mpca_stats) == 152 && ALIGNOF(mpca_stats) == 8, "mpca_stats layout");
 STATIC_ASSERT(sizeof(mpca_body_stats) == 40 && ALIGNOF(mpca_body_stats) == 8, "mpca_body_stats layout");
 STATIC_ASSERT(sizeof(mpca_particle) == 44 && ALIGNOF(mpca_particle) == 4, "mpca_particle layout");
@@ -404,6 +404,8 @@ static void description_cases(void) {
         DESC_VALUES(base, method, MPCA_STATUS_BAD_ENUM, 3, UINT32_MAX);
         DESC_VALUES(base, collisions, MPCA_STATUS_BAD_ENUM, 2, UINT32_MAX);
         DESC_VALUES(base, contacts, MPCA_STATUS_BAD_ENUM, 2, UINT32_MAX);
+        DESC_VALUES(base, rest, MPCA_STATUS_BAD_ENUM, 2, UINT32_MAX);
+        DESC_VALUES(base, reserved, MPCA_STATUS_BAD_ENUM, 1, UINT32_MAX);
         DESC_VALUES(base, energy_neutral, MPCA_STATUS_BAD_ENUM, 2, UINT32_MAX);
         DESC_VALUES(base, drag_vortex, MPCA_STATUS_BAD_ENUM, 2, UINT32_MAX);
         DESC_VALUES(base, drag_wind_field, MPCA_STATUS_BAD_ENUM, 2, UINT32_MAX);

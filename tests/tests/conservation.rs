@@ -110,7 +110,7 @@ fn closed_box(sc: &Scene) -> Outcome {
     desc.seed = sc.seed;
     desc.mass = sc.masses[0];
     desc.per_particle_mass = sc.masses.len() > 1;
-    desc.mass_classes = sc.masses.len() as u32;
+    desc.mass_classes = sc.masses.len() as u16;
     let mut mem = memory(&desc);
     let world = World::init(&desc, &mut mem).unwrap();
     let mut rng = common::test_rng(sc.seed);

@@ -156,13 +156,13 @@ fn ranges_are_checked() {
 /// are accepted; the count is ignored without per-particle masses.
 #[test]
 fn mass_classes_in_range() {
-    for classes in [0u32, 257, u32::MAX] {
+    for classes in [0u16, 257, u16::MAX] {
         let mut d = base();
         d.per_particle_mass = true;
         d.mass_classes = classes;
         refused(d, Error::CapacityRange, &format!("{classes} mass classes"));
     }
-    for classes in [1u32, 256] {
+    for classes in [1u16, 256] {
         let mut d = base();
         d.per_particle_mass = true;
         d.mass_classes = classes;

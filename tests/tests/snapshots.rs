@@ -81,10 +81,12 @@ fn small_desc() -> Description {
     d
 }
 
-/// The small world with drag towards a wind plane too (M5.1b).
+/// The small world with drag towards a wind plane too (M5.1b), and
+/// resting contact (M5.7b).
 fn windy_desc() -> Description {
     let mut d = small_desc();
     d.drag = Drag { rate: 0.05, wind: [0.0, 0.01, 0.0], field: true, vortex: false };
+    d.rest = true;
     d
 }
 

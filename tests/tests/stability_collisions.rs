@@ -162,7 +162,7 @@ fn mixed_extreme_masses_stay_finite() {
                 let mut desc = cube(dim, if dim == 2 { 32 } else { 12 });
                 desc.quantization = q;
                 desc.per_particle_mass = true;
-                desc.mass_classes = masses.len() as u32;
+                desc.mass_classes = masses.len() as u16;
                 desc.mass = masses[0];
                 desc.seed = 77;
                 let mut mem = memory(&desc);

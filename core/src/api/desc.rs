@@ -202,8 +202,11 @@ pub struct Description {
     /// Whether particles carry their own masses (feature `mass`): a one-byte
     /// index per cell into a table of `mass_classes` distinct masses.
     pub per_particle_mass: bool,
-    /// Capacity of the mass table, 1 to 256.
-    pub mass_classes: u32,
+    /// Capacity of the mass table, 1 to 256. Sixteen bits: the description
+    /// then fits the 128 bytes a step copies with inline moves, not a call
+    /// of `memcpy` on the world's memory (a C program's ThreadSanitizer
+    /// sees such calls, but not the handle's ordering of them).
+    pub mass_classes: u16,
     /// Whether the world has obstacle cells (feature `obstacles`).
     pub obstacles: bool,
     /// How many obstacle surface cells (with normal and restitution) fit;
@@ -247,6 +250,11 @@ pub struct Description {
     /// come to rest. Off: the paper's rules, where a refused particle keeps
     /// its velocity.
     pub contacts: bool,
+    /// M5.7b (beyond the paper): a particle that rests on a full support
+    /// (walls, obstacles, particles at rest) loses its velocity into the
+    /// support along the uniform force and takes no push from it, so a pool
+    /// or a pile comes to rest exactly. Off: the paper's rules.
+    pub rest: bool,
     /// M1b (beyond the paper): each collision and contact shrinks its
     /// pair's relative velocity by the kinetic energy the stochastic
     /// rounding of its results adds on average, so an elastic world keeps
@@ -293,6 +301,7 @@ impl Description {
             method: Method::ExactFast,
             collisions: Collisions::Paper,
             contacts: false,
+            rest: false,
             energy_neutral: false,
             emitter_capacity: 0,
             lifetimes: false,
@@ -382,6 +391,7 @@ impl Description {
             && self.assignment() == self.method
             && self.collision_rule() == self.collisions
             && self.has_contacts() == self.contacts
+            && self.has_rest() == self.rest
             && self.has_energy_neutral() == self.energy_neutral
             && self.identity_planes().any() == self.identity.any();
         if !kept {
@@ -465,6 +475,13 @@ impl Description {
         cfg!(feature = "collision-rules") && self.contacts
     }
 
+    /// `rest` (M5.7b), false by construction without the feature
+    /// `collision-rules`, as [`Description::has_masses`].
+    #[inline(always)]
+    pub(crate) const fn has_rest(&self) -> bool {
+        cfg!(feature = "collision-rules") && self.rest
+    }
+
     /// `energy_neutral` (M1b), false by construction without the feature
     /// `collision-rules`, as [`Description::has_masses`].
     #[inline(always)]
@@ -508,6 +525,7 @@ mod tests {
         let paper_only = want(!cfg!(feature = "collision-rules"));
         assert_eq!(Description { collisions: Collisions::SpeedLimited, ..plain }.validate(), paper_only, "M5.2b");
         assert_eq!(Description { contacts: true, ..plain }.validate(), paper_only, "M5.7");
+        assert_eq!(Description { rest: true, ..plain }.validate(), paper_only, "M5.7b");
         assert_eq!(Description { energy_neutral: true, ..plain }.validate(), paper_only, "M1b");
         // The vortex needs `vortex` (which `fields` implies), the other
         // summed forces and drag need `fields`.

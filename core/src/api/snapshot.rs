@@ -301,6 +301,7 @@ fn put_desc(p: &mut Put<'_>, d: &Description) {
         method,
         collisions,
         contacts,
+        rest,
         energy_neutral,
         drag,
         emitter_capacity,
@@ -324,7 +325,7 @@ fn put_desc(p: &mut Put<'_>, d: &Description) {
     p.u8(u8::from(energy_neutral));
     p.u8(u8::from(flow));
     p.f32(mass);
-    p.u32(mass_classes);
+    p.u32(u32::from(mass_classes));
     p.u32(surface_capacity);
     p.u32(emitter_capacity);
     gravity.iter().for_each(|&g| p.f32(g));
@@ -342,7 +343,9 @@ fn put_desc(p: &mut Put<'_>, d: &Description) {
     p.u8(u8::from(wind_plane));
     // The second, likewise: the identity planes (M6b), a bit each.
     p.u8(identity.bits() as u8);
-    p.bytes(&[0; 2]);
+    // The third, likewise: resting contact (M5.7b).
+    p.u8(u8::from(rest));
+    p.u8(0);
 }
 
 fn get_desc(g: &mut Get<'_>) -> Result<Description, Error> {
@@ -384,14 +387,18 @@ fn get_desc(g: &mut Get<'_>) -> Result<Description, Error> {
     let forces = Forces { uniform: g.flag()?, field: g.flag()?, potential: g.flag()?, vortex: g.flag()? };
     let (energy_neutral, flow) = (g.flag()?, g.flag()?);
     let mass = g.f32()?;
-    let (mass_classes, surface_capacity, emitter_capacity) = (g.u32()?, g.u32()?, g.u32()?);
+    // A capacity beyond 16 bits is ignored (masses off) or refused by the
+    // description's check anyway: kept at the largest.
+    let mass_classes = g.u32()?.min(u32::from(u16::MAX)) as u16;
+    let (surface_capacity, emitter_capacity) = (g.u32()?, g.u32()?);
     let gravity = [g.f32()?, g.f32()?, g.f32()?];
     let vortex = Vortex { centre: [g.f32()?, g.f32()?], core_radius: g.f32()?, circulation: g.f32()? };
     let (restitution, wall_restitution, dt) = (g.f32()?, g.f32()?, g.f32()?);
     let (rate, wind) = (g.f32()?, [g.f32()?, g.f32()?, g.f32()?]);
     let drag = Drag { rate, wind, field: g.flag()?, vortex: flow };
     let identity = Identity::from_bits(u32::from(g.u8()?)).ok_or(bad)?;
-    g.zeros(2)?;
+    let rest = g.flag()?;
+    g.zeros(1)?;
     Ok(Description {
         dim,
         size,
@@ -415,6 +422,7 @@ fn get_desc(g: &mut Get<'_>) -> Result<Description, Error> {
         method,
         collisions,
         contacts,
+        rest,
         energy_neutral,
         drag,
         emitter_capacity,

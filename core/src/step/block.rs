@@ -293,6 +293,8 @@ pub(crate) struct Shared<'a> {
     pub lean_push: Option<[i32; 3]>,
     /// M5.2's restitution in Q16 (M1c's `E`).
     pub restitution: i32,
+    /// M5.7b's support, where it is on and the uniform push is not zero.
+    pub rest: Option<crate::step::rest::Support>,
     /// M5.1b flow drag, where its rate is not 0.
     pub drag: Option<Flow<'a>>,
     /// The 8-bit move table of the drift rule (M5.3).

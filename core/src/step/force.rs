@@ -34,9 +34,10 @@ impl<const D: usize, const CELLS: usize> Kernel<'_, D, CELLS> {
     /// M5.1 external force on every particle of `b`: `v <- v + dt F / m`
     /// (eqs. 4-5), in fine units, then the clamp. A force that changes
     /// nothing is no step 1: a zero-valued part gives the same world as a
-    /// world without it (M9).
+    /// world without it (M9). The particles of `resting` take no uniform
+    /// push (M5.7b).
     #[inline(always)]
-    pub(crate) fn force<W: Widths, P: Parts>(&mut self, site: &Site<'_>, b: &impl Stored<D>, changes: &mut Changes<CELLS>, carried: &Carried<CELLS>) {
+    pub(crate) fn force<W: Widths, P: Parts>(&mut self, site: &Site<'_>, b: &impl Stored<D>, changes: &mut Changes<CELLS>, carried: &Carried<CELLS>, resting: u8) {
         let sh = self.shared;
         let fine = W::width(sh).fine;
         // A plain block's uniform force, small enough to add in 32 bits;
@@ -50,11 +51,17 @@ impl<const D: usize, const CELLS: usize> Kernel<'_, D, CELLS> {
         } else if P::ALL {
             for c in cells_of(b.occ()) {
                 let class = carried.class(sh, c);
-                let dv = if sh.summed {
+                let mut dv = if sh.summed {
                     sh.terms.push(sh.part.cell_coords(site.row, [site.xs[c & 1], 0, 0], c), site.cell(c), &class)
                 } else {
                     sh.push.unwrap_or_default()
                 };
+                // M5.7b: the sum less the uniform push, which a resting
+                // particle's support takes (the sum is exact: M1c).
+                if resting >> c & 1 != 0 {
+                    let g = sh.push.unwrap_or_default();
+                    dv = [dv[0] - g[0], dv[1] - g[1], dv[2] - g[2]];
+                }
                 // Component by component: an array comparison is a
                 // `memcmp` call on small cores.
                 if dv[0] | dv[1] | dv[2] != 0 {

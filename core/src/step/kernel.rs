@@ -73,6 +73,7 @@ use crate::step::block::{cells_of, each_occupied, Bare, Block, Carried, Every, K
 #[cfg(feature = "identity")]
 use crate::step::identity::carry;
 use crate::step::contacts::contacts;
+use crate::step::rest::Resting;
 use crate::step::lanes::Lanes;
 use crate::step::partition::{cells_at, BlockRow, BlockSink, Index};
 use crate::step::rounding::{round_apart, Changes};
@@ -265,9 +266,15 @@ impl<const D: usize, const CELLS: usize> Kernel<'_, D, CELLS> {
             return;
         }
         let mut changes = Changes::<CELLS>::new();
-        self.force::<W, P>(site, b, &mut changes, carried);
+        // M5.7b: what the block's particles rest on (nothing without it).
+        let support = if P::ALL { sh.rest } else { None };
+        let resting = support.map_or(Resting::NONE, |s| s.read(&*b, site.blocked));
+        self.force::<W, P>(site, b, &mut changes, carried, resting.cells);
         if P::ALL {
             self.drag::<W>(site, b, &mut changes, carried);
+        }
+        if let (Some(s), true) = (support, resting.held) {
+            s.settle::<D, CELLS>(&*b, &mut changes, w.fine, resting, sh.restitution);
         }
         if let Some((a, c)) = pair {
             let (va, vc) = (changes.velocity(b, a, w.fine), changes.velocity(b, c, w.fine));

@@ -25,6 +25,7 @@ pub(crate) mod lanes;
 pub(crate) mod moves;
 pub(crate) mod partition;
 pub(crate) mod reflection;
+pub(crate) mod rest;
 pub(crate) mod rounding;
 #[cfg(target_has_atomic = "8")]
 pub(crate) mod tasks;
@@ -38,6 +39,7 @@ use crate::rules::class::Class;
 use crate::step::block::Identified;
 use crate::step::block::{Shared, Typed, Velocity, Writable};
 use crate::step::block::Kernel;
+use crate::step::rest::Support;
 use crate::step::kernel::Sink;
 use crate::step::partition::Partition;
 use crate::storage::cells::Cells;
@@ -292,7 +294,7 @@ impl World {
         // With `small-step` every block takes the pipeline with every part:
         // nothing is plain, and nothing only the plain ones read is set up.
         let lean = !cfg!(feature = "small-step") && lean;
-        let plain = lean && !desc.has_masses() && !desc.lifetimes && !desc.identity_planes().any() && !summed && small_push;
+        let plain = lean && !desc.has_rest() && !desc.has_masses() && !desc.lifetimes && !desc.identity_planes().any() && !summed && small_push;
         let shared = Shared {
             #[cfg(feature = "small-step")]
             desc,
@@ -311,6 +313,7 @@ impl World {
             push: pushes.then_some(push),
             lean_push: if lean && small_push && pushes { Some(push.map(|g| g as i32)) } else { None },
             restitution: scaled(desc.restitution, 1.0, 16) as i32,
+            rest: if desc.has_rest() { Support::of(push, dim, fine as u32) } else { None },
             terms,
             drag: desc.has_drag().then(|| Flow {
                 wind: desc.drag.wind.map(|u| to_fine(u, (s, fine))),

@@ -755,7 +755,8 @@ fn additions(r: &Results) -> Table {
         "Each rule beyond the paper on the scene where it shows, against the paper's rule: the paper's smoke (480 \
          steps, its vortex as a force) against the smoke with flow drag (its 1,200 steps); the e = 1 cluster with \
          the paper's collisions and with speed-limited ones; the poured water pool (e = 0.5) without and with \
-         contacts; an elastic 8-bit gas in a 128² box with walls (density 0.3, speed-limited collisions, so no \
+         contacts, and with contacts without and with resting contact (M5.7b: the \"paper rule\" column is \
+         then M5.7 alone); an elastic 8-bit gas in a 128² box with walls (density 0.3, speed-limited collisions, so no \
          clamp) with unbiased and with energy-neutral rounding. The figures the tests of `tests/tests/effects.rs` \
          hold to their bounds. One timed run each.",
         vec![
