@@ -155,20 +155,22 @@ static const char *const SURFACE_FS =
     "    gl_FragColor = vec4(min(c, 1.0), edge);\n"
     "}\n";
 
-/* A grain's size and brightness stray from the mean by its seed, and its
- * hue a little towards red or blue, so a pile of one material still reads
- * as many grains. */
+/* A grain's size and brightness stray from the mean by its seed, its hue a
+ * little towards red or blue, and its place off its cell's centre by up to
+ * `scatter` cells, so a pile of one material still reads as many grains
+ * and not as the automaton's lattice. */
 static const char *const GRAINS_VS =
     "#version 120\n"
     "uniform mat4 mvp;\n"
-    "uniform float blend, grain_px, jitter, materials;\n"
+    "uniform float blend, grain_px, jitter, scatter, materials;\n"
     "attribute vec4 motion;\n"
     "attribute vec4 traits;\n"
     "varying float material;\n"
     "varying vec3 tint;\n"
     "void main() {\n"
-    "    gl_Position = mvp * vec4(mix(motion.xy, motion.zw, blend), 0.0, 1.0);\n"
     "    float a = fract(traits.z * 97.31), b = fract(traits.z * 13.73 + 0.37);\n"
+    "    vec2 off = scatter * (2.0 * vec2(fract(traits.z * 53.17), fract(traits.z * 71.71)) - 1.0);\n"
+    "    gl_Position = mvp * vec4(mix(motion.xy, motion.zw, blend) + off, 0.0, 1.0);\n"
     "    gl_PointSize = grain_px * (0.85 + 0.3 * a);\n"
     "    material = (min(traits.y, materials - 1.0) + 0.5) / materials;\n"
     "    float bright = 1.0 + jitter * (2.0 * traits.z - 1.0);\n"
@@ -524,6 +526,7 @@ void engine_draw_grains(engine *e, const float mvp[16], const grain_look *g) {
     uniform1(p, "blend", g->blend);
     uniform1(p, "grain_px", g->grain_px);
     uniform1(p, "jitter", g->jitter);
+    uniform1(p, "scatter", g->scatter);
     uniform1(p, "materials", (float)materials);
     glUniform1i(glGetUniformLocation(p, "palette"), 0);
     /* Opaque: a grain is drawn over whatever is there. */

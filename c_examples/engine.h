@@ -91,6 +91,7 @@ typedef struct grain_look {
     float blend;              /* between the two steps, as for smoke */
     float grain_px;           /* a grain's mean diameter in pixels */
     float jitter;             /* how far a grain's brightness strays, 0..1 */
+    float scatter;            /* how far off its cell's centre it is drawn, in cells */
     const float (*colours)[3]; /* a colour per tag, RGB 0..1 */
     uint32_t materials;       /* how many; larger tags take the last */
 } grain_look;

@@ -356,6 +356,7 @@ static void draw_sand(const scene_opts *o, float blend, const view *v) {
         .blend = blend,
         .grain_px = (float)v->cell_px,
         .jitter = 0.18f,
+        .scatter = 0.12f,
         .colours = SAND_COLOURS,
         .materials = SAND_MATERIALS,
     };
