@@ -257,6 +257,7 @@ static mpca_world *build_water(const scene_opts *o) {
 static void water_before_step(mpca_world *w, const scene_opts *o, uint64_t t) {
     if (t == (uint64_t)(WATER_POUR_SHARE * (double)o->steps)) {
         mpca_check(mpca_world_set_emitter_rate(w, 0, 0.0f), "mpca_world_set_emitter_rate");
+        printf("tap: closed step=%llu\n", (unsigned long long)t);
     }
 }
 
