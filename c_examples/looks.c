@@ -181,10 +181,11 @@ static void draw_smoke(const scene_opts *o, float blend, const view *v) {
 /* Water at a gentler gravity than docs/model.md's 0.0136 (cells of 5 cm at
  * 120 steps a second), at which a few rows of still water push their
  * bottom row to the speed cap (issue 28, M5.7's open point). Contacts on
- * (M5.7), and a high restitution: under today's rules a particle moves
- * sideways only after a collision gives it sideways speed, so water with a
- * low one stacks into a standing column under the tap, while at 0.8 it
- * spreads into a level pool (mean speed 0.13 left, no clamp). */
+ * (M5.7), and a high restitution for the water and every surface: under
+ * today's rules a particle moves sideways only after a collision gives it
+ * sideways speed, so water with a low one stacks into a standing column
+ * where it lands and a heap against whatever it is thrown at, while at
+ * 0.95 it keeps jostling and spreads into a level pool. */
 static void water_desc(mpca_desc *d, uint32_t size) {
     mpca_check(mpca_desc_defaults(d, 2, size, size, 0), "mpca_desc_defaults");
     for (int axis = 0; axis < 2; axis++) {

@@ -164,7 +164,7 @@ if [ "$docs" -eq 1 ]; then
         box2d-wheel) l="$logs/box2d-wheel.log"
             echo "C++ (\`c_examples/box2d_wheel.cpp\`, Box2D 2.4 from Debian's \`libbox2d-dev\`): a Box2D wheel (six blades, radius 1.2 m, on a pin whose friction holds back 100 N m) under a waterfall of 3 particles a step at cells of 5 cm and 120 steps a second (two a Box2D step at 60 Hz; a particle is 1 kg). Each blade is a capsule body moved from Box2D's pose before every step; the water's momentum on it, negated, is an impulse at the blade's middle. It turns the wheel clockwise (the program prints clockwise speeds and torques as negative): $(unsign "$(field "$l" 'wheel: t=1s' rpm)") turns a minute after 1 s and $(unsign "$(field "$l" 'wheel: t=5s' rpm)") after 5 s, against $(unsign "$(field "$l" 'wheel: t=5s' dry_rpm)") for the same wheel in a Box2D world without the water; over the last second the water's torque averaged $(unsign "$(field "$l" 'water: ' torque)") N m, against the pin's load of 100. The section on bodies below says why a waterfall and not a pool.";;
         looks-smoke) l="$logs/looks-smoke.log"
-            echo "soft sprites: each particle a puff of a radial falloff broken up by noise, turned by an angle of its own, growing from 2.5 to 10 cells and fading out as its age nears its lifetime of 240 steps (the ages of M6b), laid over the others with premultiplied alpha, part of the way between its last two cells. The world (\`smoke_desc\`): buoyancy 0.0069, drag 0.033 towards a breeze of 0.04 cells per step, speed-limited collisions; a vent 8 cells wide puffs at 0.6 cells per step ($(commas "$(field "$l" 'end: ' emitted)") particles emitted over $(field "$l" 'end: ' step) steps, no clamp: $(field "$l" 'end: ' clamps)).";;
+            echo "soft sprites: each particle a puff of a radial falloff broken up by noise, turned by an angle of its own, growing from 2.5 to 10 cells and fading out as its age nears its lifetime of 240 steps (the ages of M6b), laid over the others with premultiplied alpha, part of the way between its last two cells. The world (\`smoke_desc\`): buoyancy 0.0069, drag 0.033 towards a breeze of 0.04 cells per step, speed-limited collisions; a vent 8 cells wide puffs at 0.6 cells per step ($(commas "$(field "$l" 'end: ' emitted)") particles emitted over $(field "$l" 'end: ' step) steps, $(field "$l" 'end: ' clamps) clamps).";;
         looks-water) l="$logs/looks-water.log"
             echo "a surface: every particle splatted as a blurred disc (radius 2.5 cells) into an offscreen density image behind a framebuffer object, mirrored behind the walls; a second pass keeps where the density passes half a packed body's, tints it darker with the water above it, lights it by its slope, whitens it where the particles travel (foam) and draws a lone particle as a faint drop. The world (\`water_desc\`): gravity 0.005, e = 0.95 for water, walls and stones, contacts; a tap pours into a pool with two stones and closes at step $(field "$l" 'tap: ' step); at the end $(commas "$(field "$l" 'end: ' particles)") particles, a mean speed of $(field "$l" 'look: ' mean_speed) and a share of $(field "$l" 'look: ' changed_cell) changing cell in a step.";;
         looks-sand) l="$logs/looks-sand.log"
@@ -221,7 +221,7 @@ if [ "$docs" -eq 1 ]; then
         done
         echo "### Drawn as a game would: smoke, water, sand"
         echo
-        echo "The scenes above draw every particle as what it is, a square in its cell."
+        echo "The scenes above draw every particle as itself, a point coloured by speed."
         echo "These draw the same library's particles as a game engine draws the three"
         echo "effects (\`c_examples/looks.c\`, one source built as \`looks-smoke\`,"
         echo "\`looks-water\` and \`looks-sand\`; the drawing in \`c_examples/engine.c\`,"
@@ -259,8 +259,10 @@ if [ "$docs" -eq 1 ]; then
         echo "forces, emitters, obstacles, step counts): \`cargo test\` runs each C program"
         echo "for a few steps at full size and checks that its world hashes equal to the"
         echo "Rust scene's, and runs each at a small size and checks its images"
-        echo "(wake and box2d-wheel, which have no Rust twin, only the latter, with their"
-        echo "own figures: the clear strip behind the disc, the wheel the water turns)."
+        echo "(wake, box2d-wheel and the three looks, which have no Rust twin, only the"
+        echo "latter, with their own figures: the clear strip behind the disc, the wheel"
+        echo "the water turns, the effect drawn over the fixed parts and every emitted"
+        echo "particle followed by id)."
     } > "$logs/section.md"
     # Splice the section into README.md between its markers.
     awk -v section="$logs/section.md" '
