@@ -444,8 +444,11 @@ void engine_draw_liquid(engine *e, const float mvp[16], uint32_t width, uint32_t
     /* Pass 1: the splats, added up in the density image. */
     bind_density(e, w, h);
     glViewport(0, 0, (GLsizei)w, (GLsizei)h);
+    GLfloat clear[4];
+    glGetFloatv(GL_COLOR_CLEAR_VALUE, clear);
     glClearColor(0.0f, 0.0f, 0.0f, 0.0f);
     glClear(GL_COLOR_BUFFER_BIT);
+    glClearColor(clear[0], clear[1], clear[2], clear[3]);
     GLuint p = e->splat;
     glUseProgram(p);
     glUniformMatrix4fv(glGetUniformLocation(p, "mvp"), 1, GL_FALSE, wide);
