@@ -15,6 +15,7 @@
 #include <GL/osmesa.h>
 
 #include "common.h"
+#include "engine.h"
 #include "gpu.h"
 #include "image.h"
 
@@ -71,6 +72,15 @@ static gpu *shaders;
 static gpu *gpu_of_canvas(void) {
     if (!shaders) shaders = gpu_create();
     return shaders;
+}
+
+/* The effects' drawing (engine.h), created at its first use as the shader
+ * path is. */
+static engine *effects;
+
+static engine *engine_of_canvas(void) {
+    if (!effects) effects = engine_create();
+    return effects;
 }
 
 /* The product of GL's projection and model-view matrices, as the shaders
@@ -154,6 +164,62 @@ void draw_walls_2d(const mpca_desc *desc, const view *v) {
     }
     glPopMatrix();
     glMatrixMode(GL_MODELVIEW);
+}
+
+void draw_shape_2d(const mpca_shape *shape, float level) {
+    enum { SEGMENTS = 72 };
+    grey(level);
+    if (shape->kind == MPCA_SHAPE_KIND_BOX) {
+        glRectf(shape->a[0], shape->a[1], shape->b[0], shape->b[1]);
+    } else if (shape->kind == MPCA_SHAPE_KIND_DISC) {
+        glBegin(GL_TRIANGLE_FAN);
+        glVertex2f(shape->a[0], shape->a[1]);
+        for (int i = 0; i <= SEGMENTS; i++) {
+            float t = 2.0f * PI_F * (float)i / SEGMENTS;
+            glVertex2f(shape->a[0] + shape->radius * cosf(t), shape->a[1] + shape->radius * sinf(t));
+        }
+        glEnd();
+    } else if (shape->kind == MPCA_SHAPE_KIND_HALF_SPACE) {
+        /* The far side of the line through a with normal b, cut to a
+         * square far larger than any view. */
+        float nx = shape->b[0], ny = shape->b[1], len = sqrtf(nx * nx + ny * ny);
+        if (len == 0.0f) return;
+        nx /= len;
+        ny /= len;
+        const float far = 1e5f, x = shape->a[0], y = shape->a[1];
+        glBegin(GL_QUADS);
+        glVertex2f(x - far * ny, y + far * nx);
+        glVertex2f(x + far * ny, y - far * nx);
+        glVertex2f(x + far * ny - far * nx, y - far * nx - far * ny);
+        glVertex2f(x - far * ny - far * nx, y + far * nx - far * ny);
+        glEnd();
+    }
+}
+
+void upload_moving_2d(const moving *particles, size_t n) {
+    engine_upload(engine_of_canvas(), particles, n);
+}
+
+void draw_puffs_2d(const smoke_look *s) {
+    float mvp[16];
+    current_mvp(mvp);
+    engine_draw_smoke(engine_of_canvas(), mvp, s);
+}
+
+void draw_liquid_2d(const liquid_look *l, const view *v) {
+    liquid_look at = *l;
+    at.cell_px = (float)v->cell_px;
+    at.cells[0] = (float)v->width / (float)v->cell_px;
+    at.cells[1] = (float)v->height / (float)v->cell_px;
+    float mvp[16];
+    current_mvp(mvp);
+    engine_draw_liquid(engine_of_canvas(), mvp, v->width, v->height, &at);
+}
+
+void draw_grains_2d(const grain_look *g) {
+    float mvp[16];
+    current_mvp(mvp);
+    engine_draw_grains(engine_of_canvas(), mvp, g);
 }
 
 /* ---- 3D ---------------------------------------------------------------------- */
@@ -314,6 +380,8 @@ void canvas_destroy(canvas *c) {
     /* The GPU objects go with the context, which is still current. */
     gpu_destroy(shaders);
     shaders = NULL;
+    engine_destroy(effects);
+    effects = NULL;
     OSMesaDestroyContext(c->ctx);
     free(c);
 }

@@ -19,6 +19,7 @@
 
 #include <GL/gl.h>
 
+#include "engine.h"
 #include "mpca.h"
 
 /* What one drawing call renders into: the pixel size of the image and, in
@@ -71,6 +72,21 @@ void draw_motion_2d(float blend, float lifetime, float sprite_px, float peak);
 /* 2D: the faces of the domain that are walls, as grey lines two pixels
  * wide along the image border. */
 void draw_walls_2d(const mpca_desc *desc, const view *v);
+/* 2D: an obstacle shape (a box or a disc; a half-space up to the view's
+ * edge) as a solid grey of `level`, over what is drawn. */
+void draw_shape_2d(const mpca_shape *shape, float level);
+
+/* 2D, drawn as a game engine draws effects (engine.h): once a step, the
+ * particles followed between the last two steps (follow.h), into a vertex
+ * buffer; then, any number of times, */
+void upload_moving_2d(const moving *particles, size_t n);
+/* as soft puffs that grow and fade with age (smoke), */
+void draw_puffs_2d(const smoke_look *s);
+/* as a shaded liquid surface over the frame `v`, splatted from them
+ * (`l->cell_px` and `l->cells` are taken from `v`), */
+void draw_liquid_2d(const liquid_look *l, const view *v);
+/* or as opaque grains coloured by tag. */
+void draw_grains_2d(const grain_look *g);
 
 /* 3D: a camera looking at `target` from `eye`, y up. */
 typedef struct camera {

@@ -148,7 +148,7 @@ static const char *const SMOKE_2D_FS =
 
 /* ---- GL helpers --------------------------------------------------------- */
 
-static void gl_check(const char *what) {
+void gpu_check(const char *what) {
     GLenum err = glGetError();
     if (err != GL_NO_ERROR) {
         fprintf(stderr, "OpenGL error 0x%x in %s\n", (unsigned)err, what);
@@ -171,10 +171,10 @@ static GLuint compile(GLenum kind, const char *source, const char *name) {
     return shader;
 }
 
-/* A program from two shaders; attribute 0 is `position` (or `corner`, or
- * `motion`), 1 is `velocity` (or `age`), bound before linking so every
- * program agrees. */
-static GLuint link(const char *vs, const char *fs, const char *name) {
+/* Attribute 0 is `position` (or `corner`, or `motion`), 1 is `velocity`
+ * (or `age`, or `traits`), bound before linking so every program agrees
+ * (engine.c's too). */
+GLuint gpu_program(const char *vs, const char *fs, const char *name) {
     GLuint program = glCreateProgram();
     GLuint v = compile(GL_VERTEX_SHADER, vs, name), f = compile(GL_FRAGMENT_SHADER, fs, name);
     glAttachShader(program, v);
@@ -184,6 +184,7 @@ static GLuint link(const char *vs, const char *fs, const char *name) {
     glBindAttribLocation(program, 0, "motion");
     glBindAttribLocation(program, 1, "velocity");
     glBindAttribLocation(program, 1, "age");
+    glBindAttribLocation(program, 1, "traits");
     glLinkProgram(program);
     glDeleteShader(v); /* freed with the program */
     glDeleteShader(f);
@@ -245,10 +246,10 @@ static const uint8_t PALETTE_SMOKE[4][3] = {{255, 214, 110}, {245, 135, 55}, {20
 
 gpu *gpu_create(void) {
     gpu *g = xrealloc(NULL, sizeof *g);
-    g->points_2d = link(POINTS_2D_VS, POINTS_2D_FS, "points_2d");
-    g->sprites_3d = link(SPRITES_3D_VS, SPRITES_3D_FS, "sprites_3d");
-    g->density_program = link(DENSITY_VS, DENSITY_FS, "density");
-    g->smoke_2d = link(SMOKE_2D_VS, SMOKE_2D_FS, "smoke_2d");
+    g->points_2d = gpu_program(POINTS_2D_VS, POINTS_2D_FS, "points_2d");
+    g->sprites_3d = gpu_program(SPRITES_3D_VS, SPRITES_3D_FS, "sprites_3d");
+    g->density_program = gpu_program(DENSITY_VS, DENSITY_FS, "density");
+    g->smoke_2d = gpu_program(SMOKE_2D_VS, SMOKE_2D_FS, "smoke_2d");
     glGenBuffers(1, &g->particles);
     glGenBuffers(1, &g->motion);
     g->motion_capacity = 0;
@@ -266,7 +267,7 @@ gpu *gpu_create(void) {
     glGenTextures(1, &g->density);
     g->res[0] = g->res[1] = 0;
     g->density_bytes = NULL;
-    gl_check("gpu_create");
+    gpu_check("gpu_create");
     return g;
 }
 
@@ -314,7 +315,7 @@ size_t gpu_upload_particles(gpu *g, const mpca_world *w) {
     }
     glBindBuffer(GL_ARRAY_BUFFER, 0);
     g->count = got;
-    gl_check("gpu_upload_particles");
+    gpu_check("gpu_upload_particles");
     return got;
 }
 
@@ -352,7 +353,7 @@ void gpu_draw_points_2d(gpu *g, const float mvp[16], float point_px) {
     glDisable(GL_POINT_SMOOTH);
     glDisable(GL_BLEND);
     draw_particles(g, p, g->palette_2d, 5);
-    gl_check("gpu_draw_points_2d");
+    gpu_check("gpu_draw_points_2d");
 }
 
 void gpu_draw_sprites_3d(gpu *g, const float mvp[16], const gpu_sprites *s) {
@@ -371,7 +372,7 @@ void gpu_draw_sprites_3d(gpu *g, const float mvp[16], const gpu_sprites *s) {
     glEnable(GL_POINT_SPRITE);
     draw_particles(g, p, g->palette_3d, 3);
     glDisable(GL_POINT_SPRITE);
-    gl_check("gpu_draw_sprites_3d");
+    gpu_check("gpu_draw_sprites_3d");
 }
 
 /* ---- motion between steps ---------------------------------------------------- */
@@ -402,7 +403,7 @@ void gpu_upload_motion_2d(gpu *g, const float *from, const float *to, const uint
         return;
     }
     g->motion_count = n;
-    gl_check("gpu_upload_motion_2d");
+    gpu_check("gpu_upload_motion_2d");
 }
 
 void gpu_draw_smoke_2d(gpu *g, const float mvp[16], const gpu_smoke *s) {
@@ -439,7 +440,7 @@ void gpu_draw_smoke_2d(gpu *g, const float mvp[16], const gpu_smoke *s) {
     glBindBuffer(GL_ARRAY_BUFFER, 0);
     glBindTexture(GL_TEXTURE_2D, 0);
     glUseProgram(0);
-    gl_check("gpu_draw_smoke_2d");
+    gpu_check("gpu_draw_smoke_2d");
 }
 
 /* ---- density --------------------------------------------------------------- */
@@ -471,7 +472,7 @@ void gpu_upload_density_2d(gpu *g, const mpca_world *w, uint32_t bin) {
                         g->density_bytes);
     }
     glBindTexture(GL_TEXTURE_2D, 0);
-    gl_check("gpu_upload_density_2d");
+    gpu_check("gpu_upload_density_2d");
 }
 
 void gpu_draw_density_2d(gpu *g, const float mvp[16], uint32_t nx, uint32_t ny, const float bg[3], float full) {
@@ -494,5 +495,5 @@ void gpu_draw_density_2d(gpu *g, const float mvp[16], uint32_t nx, uint32_t ny, 
     glBindBuffer(GL_ARRAY_BUFFER, 0);
     glBindTexture(GL_TEXTURE_2D, 0);
     glUseProgram(0);
-    gl_check("gpu_draw_density_2d");
+    gpu_check("gpu_draw_density_2d");
 }

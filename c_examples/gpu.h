@@ -30,9 +30,18 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include <GL/gl.h>
+
 #include "mpca.h"
 
 typedef struct gpu gpu;
+
+/* A shader program from GLSL sources, its attributes bound to the
+ * locations every program here uses; ends the program with the compiler's
+ * log when it does not compile or link. */
+GLuint gpu_program(const char *vs, const char *fs, const char *name);
+/* Ends the program with a message naming `what` on a GL error. */
+void gpu_check(const char *what);
 
 /* Compiles the shaders, creates the buffers and the palette textures. */
 gpu *gpu_create(void);

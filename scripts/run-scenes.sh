@@ -4,7 +4,8 @@
 # scenes at full size (and the smoke scene a second, longer time, and with
 # flow drag, M5.1b; and smoke-ids, smoke drawn between steps by id and
 # faded by age, M6b; and the moving bodies of M13: wake, a disc through
-# smoke, and box2d-wheel, a Box2D water wheel under a waterfall), and says
+# smoke, and box2d-wheel, a Box2D water wheel under a waterfall; and smoke,
+# water and sand drawn as a game engine draws them, looks-*), and says
 # where the images (PNG frames, contact sheets, animated GIFs) are and how
 # long the simulation took.
 #
@@ -53,7 +54,10 @@ make -C c_examples --no-print-directory MPCA_LIB="$lib" BUILD="$bin" CC="$cc"
 echo "== the scenes, full size, images in $out"
 logs=$(mktemp -d)
 trap 'rm -rf "$logs"' EXIT
-runs=(aggregation cluster smoke water smoke-long smoke-flow water-pool smoke-ids wake box2d-wheel)
+# The effects drawn as a game would: their own subsection of the README.
+looks=(looks-smoke looks-water looks-sand)
+runs=(aggregation cluster smoke water smoke-long smoke-flow water-pool smoke-ids wake box2d-wheel "${looks[@]}")
+is_look() { case "$1" in looks-*) return 0;; *) return 1;; esac; }
 # Images to be checked in are compressed harder: size matters there, the
 # time does not.
 png=()
@@ -138,7 +142,10 @@ if [ "$docs" -eq 1 ]; then
         water-pool) echo "4.4 water poured into a pool (M5.7 contacts, beyond the paper)";;
         smoke-ids) echo "smoke tracked by id, faded by age (M6b, beyond the paper)";;
         wake) echo "a ball through smoke (M13 bodies, beyond the paper)";;
-        box2d-wheel) echo "a Box2D water wheel under a waterfall (M13 bodies with Box2D, beyond the paper)";; esac; }
+        box2d-wheel) echo "a Box2D water wheel under a waterfall (M13 bodies with Box2D, beyond the paper)";;
+        looks-smoke) echo "smoke drawn as a game would";;
+        looks-water) echo "water drawn as a game would";;
+        looks-sand) echo "sand drawn as a game would";; esac; }
     # A field of a program's own line in its log: field LOG PREFIX KEY.
     field() { grep "^$2" "$1" | head -n 1 | tr ' ' '\n' | sed -n "s/^$3=//p"; }
     # -46.6 -> 46.6
@@ -156,6 +163,12 @@ if [ "$docs" -eq 1 ]; then
             echo "a disc body (radius 6 cells, e = 0.5) moved across at 0.4 cells per step through smoke that rises with the air at 0.15 cells per step (drag 0.05 towards it, a density of 0.3 kept by a vent along the ground, periodic across). Before every step \`mpca_world_move_body\` puts the disc a step further on; the smoke it takes is pushed out ahead of it and the smoke it meets bounces off it, and the channel it leaves rises with the smoke: over the crossing the 8 cells behind the disc held $(field "$l" 'wake: ' behind) particles a cell against $(field "$l" 'wake: ' ahead) in the same rows ahead of it, and the disc handed the smoke $(field "$l" 'wake: ' momentum_per_step) (mass × cells per step) a step, from $(field "$l" 'wake: ' reflected) reflections and $(field "$l" 'wake: ' pushed) push-outs ($(field "$l" 'wake: ' crushed) particles crushed). The haze is the density in bins of 8 × 8 cells.";;
         box2d-wheel) l="$logs/box2d-wheel.log"
             echo "C++ (\`c_examples/box2d_wheel.cpp\`, Box2D 2.4 from Debian's \`libbox2d-dev\`): a Box2D wheel (six blades, radius 1.2 m, on a pin whose friction holds back 100 N m) under a waterfall of 3 particles a step at cells of 5 cm and 120 steps a second (two a Box2D step at 60 Hz; a particle is 1 kg). Each blade is a capsule body moved from Box2D's pose before every step; the water's momentum on it, negated, is an impulse at the blade's middle. It turns the wheel clockwise (the program prints clockwise speeds and torques as negative): $(unsign "$(field "$l" 'wheel: t=1s' rpm)") turns a minute after 1 s and $(unsign "$(field "$l" 'wheel: t=5s' rpm)") after 5 s, against $(unsign "$(field "$l" 'wheel: t=5s' dry_rpm)") for the same wheel in a Box2D world without the water; over the last second the water's torque averaged $(unsign "$(field "$l" 'water: ' torque)") N m, against the pin's load of 100. The section on bodies below says why a waterfall and not a pool.";;
+        looks-smoke) l="$logs/looks-smoke.log"
+            echo "soft sprites: each particle a puff of a radial falloff broken up by noise, turned by an angle of its own, growing from 2.5 to 10 cells and fading out as its age nears its lifetime of 240 steps (the ages of M6b), laid over the others with premultiplied alpha, part of the way between its last two cells. The world (\`smoke_desc\`): buoyancy 0.0069, drag 0.033 towards a breeze of 0.04 cells per step, speed-limited collisions; a vent 8 cells wide puffs at 0.6 cells per step ($(commas "$(field "$l" 'end: ' emitted)") particles emitted over $(field "$l" 'end: ' step) steps, $(field "$l" 'end: ' clamps) clamps).";;
+        looks-water) l="$logs/looks-water.log"
+            echo "a surface: every particle splatted as a blurred disc (radius 2.5 cells) into an offscreen density image behind a framebuffer object, mirrored behind the walls; a second pass keeps where the density passes half a packed body's, tints it darker with the water above it, lights it by its slope, whitens it where the particles travel (foam) and draws a lone particle as a faint drop. The world (\`water_desc\`): gravity 0.005, e = 0.95 for water, walls and stones, contacts; a tap pours into a pool with two stones and closes at step $(field "$l" 'tap: ' step); at the end $(commas "$(field "$l" 'end: ' particles)") particles, a mean speed of $(field "$l" 'look: ' mean_speed) and a share of $(field "$l" 'look: ' changed_cell) changing cell in a step.";;
+        looks-sand) l="$logs/looks-sand.log"
+            echo "grains: each particle an opaque bead about a cell wide, lit from the upper left, coloured by its tag (M6b) as one of four materials (the spout's tag changes every 250 steps, so the mound shows its layers), its brightness, hue, size and place jittered by its id. The world (\`sand_desc\`): gravity 0.0136, e = 0.1 for grains and walls, contacts; a slot 24 cells wide pours a grain a step ($(commas "$(field "$l" 'end: ' particles)") grains).";;
     esac; }
     # 12345 -> 12,345
     commas() { echo "$1" | sed ':a;s/\B[0-9]\{3\}\>/,&/;ta'; }
@@ -186,21 +199,43 @@ if [ "$docs" -eq 1 ]; then
         echo "It installs what is missing (\`make\`, \`libosmesa6-dev\`, \`libpng-dev\`,"
         echo "\`libgif-dev\`, \`libbox2d-dev\`, with \`apt-get\` as root or through \`sudo\`), builds \`libmpca\` in release"
         echo "mode and the programs with \`make\`, runs the four scenes at full size (and"
-        echo "the smoke scene a second time, for 480 steps, and with flow drag, and the water poured into a pool; and smoke drawn between steps by id; and two scenes of moving bodies, one of them coupled with Box2D) and prints where the images"
+        echo "the smoke scene a second time, for 480 steps, and with flow drag, and the water poured into a pool; and smoke drawn between steps by id; and two scenes of moving bodies, one of them coupled with Box2D; and smoke, water and sand drawn as a game would) and prints where the images"
         echo "are: \`out/scenes/\`. Each program also runs alone, e.g."
         echo "\`target/c_examples/water --size 32 --steps 200 --every 20 --out /tmp/w\`;"
         echo "\`--help\` lists its options (\`--size --steps --seed --every --tiles --px --out --name --threads --density --gif --png-level --progress --quiet --version\`);"
         echo "on a terminal, a run that takes over a second reports its progress on"
         echo "stderr every 10 % (\`--quiet\` turns that off)."
         echo
+        # A run's caption, sheet and GIF.
+        show() {
+            echo "**$(section "$1")**: $(caption "$1")"
+            echo
+            echo "![$(section "$1"): contact sheet](docs/scenes/$1.png)"
+            echo
+            IFS='|' read -r frames bytes < "$logs/$1.gif-info"
+            echo "Animated: [\`docs/scenes/$1.gif\`](docs/scenes/$1.gif) ($frames frames, $((bytes / 1024)) KB)"
+            echo
+        }
         for run in "${runs[@]}"; do
-            echo "**$(section "$run")**: $(caption "$run")"
-            echo
-            echo "![$(section "$run"): contact sheet](docs/scenes/$run.png)"
-            echo
-            IFS='|' read -r frames bytes < "$logs/$run.gif-info"
-            echo "Animated: [\`docs/scenes/$run.gif\`](docs/scenes/$run.gif) ($frames frames, $((bytes / 1024)) KB)"
-            echo
+            is_look "$run" || show "$run"
+        done
+        echo "### Drawn as a game would: smoke, water, sand"
+        echo
+        echo "The scenes above draw every particle as itself, a point coloured by speed."
+        echo "These draw the same library's particles as a game engine draws the three"
+        echo "effects (\`c_examples/looks.c\`, one source built as \`looks-smoke\`,"
+        echo "\`looks-water\` and \`looks-sand\`; the drawing in \`c_examples/engine.c\`,"
+        echo "reusable through \`draw.h\`). After every step the program exports the"
+        echo "particles with their ids, sorts them by id and matches them with the last"
+        echo "step's (\`c_examples/follow.c\`), so any frame may be drawn part of the way"
+        echo "between two steps; GLSL 1.20 shaders and, for the water, a framebuffer object"
+        echo "draw them. Each effect's world is set in one function of \`looks.c\`"
+        echo "(\`smoke_desc\`, \`water_desc\`, \`sand_desc\`). The sheets are at whole"
+        echo "steps; the smoke's GIF spans its last 60 steps, the others the whole run,"
+        echo "their frames labelled with fractional steps where they fall between two."
+        echo
+        for run in "${looks[@]}"; do
+            show "$run"
         done
         echo "Simulation time only (\`mpca_world_step\`; building the world, drawing and"
         echo "writing PNGs not included; for wake and box2d-wheel, moving the bodies and reading"
@@ -224,8 +259,10 @@ if [ "$docs" -eq 1 ]; then
         echo "forces, emitters, obstacles, step counts): \`cargo test\` runs each C program"
         echo "for a few steps at full size and checks that its world hashes equal to the"
         echo "Rust scene's, and runs each at a small size and checks its images"
-        echo "(wake and box2d-wheel, which have no Rust twin, only the latter, with their"
-        echo "own figures: the clear strip behind the disc, the wheel the water turns)."
+        echo "(wake, box2d-wheel and the three looks, which have no Rust twin, only the"
+        echo "latter, with their own figures: the clear strip behind the disc, the wheel"
+        echo "the water turns, the effect drawn over the fixed parts and every emitted"
+        echo "particle followed by id)."
     } > "$logs/section.md"
     # Splice the section into README.md between its markers.
     awk -v section="$logs/section.md" '

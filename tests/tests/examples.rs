@@ -421,6 +421,77 @@ fn smoke_ids_follows_every_particle_by_id_and_draws_between_steps() {
     assert!(g.coloured > 0, "{gif_line}");
 }
 
+/// `looks-smoke`, `looks-water` and `looks-sand` (issue 28): each effect
+/// drawn as a game engine draws it, from the particles followed by id
+/// between steps. A small run of each: frames numbered in order, the sheet
+/// and the GIF at the sizes printed; at step 0 (no particle yet) a frame
+/// holds the fixed parts only, and at the end the effect covers more than
+/// them. The drawing owes nothing to a particle's square, so the bound on
+/// what it covers is loose: a quarter of a cell a particle. Water is a blue
+/// body and sand tinted grains (coloured pixels), smoke grey (none). Every
+/// emitted particle appeared once in the follower, and particles were
+/// followed from step to step.
+#[test]
+fn looks_draw_smoke_water_and_sand_from_the_particles_followed_by_id() {
+    for (effect, coloured) in [("smoke", false), ("water", true), ("sand", true)] {
+        let scene = format!("looks-{effect}");
+        let out_dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("examples").join(&scene);
+        let _ = std::fs::remove_dir_all(&out_dir);
+        let out_s = out_dir.to_string_lossy().into_owned();
+        let args =
+            ["--size", "32", "--steps", "200", "--every", "100", "--tiles", "3", "--gif", "10", "--px", "256", "--out", &out_s];
+        let stdout = run(&scene, &args);
+        println!("{stdout}");
+        let frames: Vec<&str> = stdout.lines().filter(|l| l.starts_with("frame: ")).collect();
+        assert_eq!(frames.len(), 3, "{scene}: frames at 0, 100 and 200");
+        let mut stats = Vec::new();
+        for (i, line) in frames.iter().enumerate() {
+            let f = fields(line);
+            let path = PathBuf::from(line["frame: ".len()..].split_whitespace().next().unwrap());
+            assert_eq!(path, out_dir.join(format!("{scene}-frame-{i:04}.png")), "frames numbered in order");
+            let p = pngstat(&path);
+            assert_eq!((p.width, p.height), dims(&f, line), "{}", path.display());
+            stats.push((number::<u64>(&f, "particles", line), p));
+        }
+        let (zero, fixed) = (&stats[0].0, &stats[0].1);
+        assert_eq!(*zero, 0, "{scene}: no particle at step 0");
+        assert!(fixed.nonbg > 0 && fixed.coloured == 0, "{scene}: step 0 shows the grey fixed parts only: {fixed:?}");
+        let (particles, last) = (&stats[2].0, &stats[2].1);
+        let cell_px = 256 / 32;
+        assert!(*particles > 0, "{scene}: particles at the end");
+        assert!(
+            last.nonbg >= fixed.nonbg + particles * cell_px * cell_px / 4,
+            "{scene}: {particles} particles cover {} pixels beside the {} fixed",
+            last.nonbg - fixed.nonbg.min(last.nonbg),
+            fixed.nonbg
+        );
+        if coloured {
+            assert!(last.coloured >= particles * cell_px * cell_px / 4, "{scene}: {particles} particles, {last:?}");
+        } else {
+            assert_eq!(last.coloured, 0, "{scene}: smoke is grey: {last:?}");
+        }
+        let sheet_line = stdout.lines().find(|l| l.starts_with("sheet: ")).expect("a sheet: line");
+        let sheet = pngstat(&out_dir.join(format!("{scene}-sheet.png")));
+        assert_eq!((sheet.width, sheet.height), dims(&fields(sheet_line), sheet_line));
+        let gif_line = stdout.lines().find(|l| l.starts_with("gif: ")).expect("a gif: line");
+        let g = pngstat(&out_dir.join(format!("{scene}.gif")));
+        assert_eq!(g.frames, Some(10), "{gif_line}");
+        assert_eq!((g.width, g.height), dims(&fields(gif_line), gif_line));
+        assert!(g.nonbg > fixed.nonbg / 4, "{gif_line}: the last frame drawn: {g:?}");
+
+        let end_line = stdout.lines().find(|l| l.starts_with("end: ")).expect("an end: line");
+        let look_line = stdout.lines().find(|l| l.starts_with("look: ")).expect("a look: line");
+        let (end, look) = (fields(end_line), fields(look_line));
+        assert_eq!(
+            number::<u64>(&look, "appeared", look_line),
+            number::<u64>(&end, "emitted", end_line),
+            "every emitted particle appeared once: {look_line}"
+        );
+        assert_eq!(number::<u64>(&look, "particles", look_line), *particles, "{look_line}");
+        assert!(number::<u64>(&look, "followed", look_line) > 10 * particles, "followed from step to step: {look_line}");
+    }
+}
+
 /// A small run of a 2D scene whose fixed parts (bodies, walls, haze) are
 /// all grey: every frame, tile and the GIF's last frame hold exactly
 /// `particles * point_px^2` coloured pixels (no two particles share a cell,
@@ -619,7 +690,7 @@ fn the_c_scenes_are_the_rust_scenes() {
 
 #[test]
 fn every_program_documents_and_checks_its_options() {
-    for scene in ["aggregation", "cluster", "smoke", "water", "wake", "box2d-wheel"] {
+    for scene in ["aggregation", "cluster", "smoke", "water", "wake", "looks-smoke", "looks-water", "looks-sand", "box2d-wheel"] {
         let help = run(scene, &["--help"]);
         for option in
             ["--size N", "--steps N", "--seed N", "--every N", "--tiles N", "--px N", "--out DIR", "--name S", "--threads N", "--density N", "--png-level N", "--gif N", "--progress", "--quiet", "--version"]
@@ -631,9 +702,11 @@ fn every_program_documents_and_checks_its_options() {
             assert_eq!(out.status.code(), Some(2), "{scene} {bad:?} should be refused");
         }
     }
-    // The density haze is 2D only.
-    let out = Command::new(programs().join("water")).args(["--density", "4"]).output().expect("runs");
-    assert_eq!(out.status.code(), Some(2), "water --density 4 should be refused");
+    // The density haze is 2D only, and the looks draw the effect instead.
+    for scene in ["water", "looks-smoke", "looks-water", "looks-sand"] {
+        let out = Command::new(programs().join(scene)).args(["--density", "4"]).output().expect("runs");
+        assert_eq!(out.status.code(), Some(2), "{scene} --density 4 should be refused");
+    }
 }
 
 /// `c_examples/threads.c`: the 1024^2 gas stepped on 1, 2 and 3 POSIX
@@ -655,7 +728,9 @@ fn the_threads_example_equals_the_serial_step() {
 #[test]
 fn every_example_program_prints_its_version() {
     let expected = env!("CARGO_PKG_VERSION"); // the workspace's, as mpca-ffi's
-    for program in ["aggregation", "cluster", "smoke", "water", "smoke-ids", "wake", "box2d-wheel", "threads", "cpp_example"] {
+    for program in
+        ["aggregation", "cluster", "smoke", "water", "smoke-ids", "wake", "looks-smoke", "looks-water", "looks-sand", "box2d-wheel", "threads", "cpp_example"]
+    {
         let out = run(program, &["--version"]);
         assert_eq!(out, format!("{program} (libmpca {expected})\n"), "{program} --version");
     }
