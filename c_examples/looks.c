@@ -104,7 +104,8 @@ static void draw_nozzle(const mpca_emitter *e, int below) {
 #define SMOKE_REFERENCE 64
 #define SMOKE_LIFETIME 240
 
-/* Buoyant smoke in a faint breeze at the figures of docs/model.md (Units):
+/* The library's smoke preset, with a faint breeze. Its figures are those
+ * of docs/model.md (Units):
  * cells of 2 cm, 60 steps a second, so a buoyancy of 0.5 m/s^2 is 0.0069
  * cells per step^2 up, and a drag of 0.033 a step towards the air (M5.1b)
  * brings it to its terminal rise of 0.0069 / 0.033 = 0.21 cells a step
@@ -115,17 +116,9 @@ static void draw_nozzle(const mpca_emitter *e, int below) {
  * ages let the renderer follow each puff and fade it. Open at the top and
  * the sides, with the ground a wall. */
 static void smoke_desc(mpca_desc *d, uint32_t size) {
-    mpca_check(mpca_desc_defaults(d, 2, size, size, 0), "mpca_desc_defaults");
-    d->boundary[0][0] = d->boundary[0][1] = MPCA_BOUNDARY_OPEN;
-    d->boundary[1][0] = MPCA_BOUNDARY_WALL;
-    d->boundary[1][1] = MPCA_BOUNDARY_OPEN;
-    d->collisions = MPCA_COLLISIONS_SPEED_LIMITED;
-    d->forces = MPCA_FORCE_UNIFORM;
-    d->gravity[1] = 0.0069f;
-    d->drag_rate = 0.033f;
+    mpca_check(mpca_desc_preset(d, MPCA_PRESET_SMOKE, 2, size, size, 0), "mpca_desc_preset");
+    /* A light breeze: the scene's, not the preset's. */
     d->drag_wind[0] = 0.04f;
-    d->lifetimes = 1;
-    d->identity = MPCA_IDENTITY_IDS | MPCA_IDENTITY_AGES;
 }
 
 /* The vent: 8 cells wide in the ground, puffing upwards. */
@@ -178,25 +171,14 @@ static void draw_smoke(const scene_opts *o, float blend, const view *v) {
 #define WATER_REFERENCE 96
 #define WATER_OBSTACLES 2
 
-/* Water at a gentler gravity than docs/model.md's 0.0136 (cells of 5 cm at
- * 120 steps a second), at which a few rows of still water push their
- * bottom row to the speed cap (issue 28, M5.7's open point). Contacts on
- * (M5.7), and a high restitution for the water and every surface: under
- * today's rules a particle moves sideways only after a collision gives it
- * sideways speed, so water with a low one stacks into a standing column
- * where it lands and a heap against whatever it is thrown at, while at
- * 0.95 it keeps jostling and spreads into a level pool. */
+/* The library's water preset (docs/model.md, Presets): a gentler gravity
+ * than docs/model.md's 0.0136, contacts (M5.7) and resting contact
+ * (M5.7b), and a high restitution for the water and every surface: a
+ * particle moves sideways only after a collision gives it sideways speed,
+ * so water with a low one heaps where it lands, while at 0.95 it keeps
+ * jostling, spreads into a level pool and then rests. */
 static void water_desc(mpca_desc *d, uint32_t size) {
-    mpca_check(mpca_desc_defaults(d, 2, size, size, 0), "mpca_desc_defaults");
-    for (int axis = 0; axis < 2; axis++) {
-        d->boundary[axis][0] = d->boundary[axis][1] = MPCA_BOUNDARY_WALL;
-    }
-    d->forces = MPCA_FORCE_UNIFORM;
-    d->gravity[1] = -0.005f;
-    d->restitution = 0.95f;
-    d->wall_restitution = 0.95f;
-    d->contacts = 1;
-    d->identity = MPCA_IDENTITY_IDS;
+    mpca_check(mpca_desc_preset(d, MPCA_PRESET_WATER, 2, size, size, 0), "mpca_desc_preset");
 }
 
 /* The tap, over the middle of the pool, pouring straight down: water
@@ -289,26 +271,17 @@ static void draw_water(const scene_opts *o, float blend, const view *v) {
 /* Steps between changes of the spout's material. */
 #define SAND_BAND_STEPS 250
 
-/* Sand at docs/model.md's scale (cells of 5 cm, 120 steps a second):
- * gravity 0.0136. Contacts on (M5.7) and a low restitution, so grains that
- * land stay where they land instead of bouncing; walls as dull as the
+/* The library's sand preset (docs/model.md, Presets): docs/model.md's
+ * scale (cells of 5 cm, 120 steps a second), gravity 0.0136, contacts
+ * (M5.7), resting contact (M5.7b) and a low restitution, so grains that
+ * land stay where they land and the pile rests; walls as dull as the
  * grains. Tags carry each grain's material (M6b). */
 static void sand_desc(mpca_desc *d, uint32_t size) {
-    mpca_check(mpca_desc_defaults(d, 2, size, size, 0), "mpca_desc_defaults");
-    for (int axis = 0; axis < 2; axis++) {
-        d->boundary[axis][0] = d->boundary[axis][1] = MPCA_BOUNDARY_WALL;
-    }
-    d->forces = MPCA_FORCE_UNIFORM;
-    d->gravity[1] = -0.0136f;
-    d->restitution = 0.1f;
-    d->wall_restitution = 0.1f;
-    d->contacts = 1;
-    d->identity = MPCA_IDENTITY_IDS | MPCA_IDENTITY_TAGS;
+    mpca_check(mpca_desc_preset(d, MPCA_PRESET_SAND, 2, size, size, 0), "mpca_desc_preset");
 }
 
-/* The spout: a slot a quarter of the floor wide, spraying a little. Under
- * today's rules a grain that lands on another stays on it (nothing makes
- * it roll off), so a narrow stream builds a spire as tall as the spout;
+/* The spout: a slot a quarter of the floor wide, spraying a little. A
+ * grain that lands on another stays on it (no rule makes it roll off), so a narrow stream builds a spire as tall as the spout;
  * from a wide slot the grains land side by side and the pile rises as a
  * mound, its flanks fed by the grains that land with sideways speed. */
 static mpca_emitter sand_spout(const scene_opts *o) {

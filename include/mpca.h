@@ -580,6 +580,39 @@ typedef uint32_t mpca_shape_kind;
 #endif // __cplusplus
 
 /**
+ * An effect a description can start from: values of mpca_desc_preset's
+ * `preset`.
+ */
+enum mpca_preset
+#if defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+  : uint32_t
+#endif // defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+ {
+  /**
+   * Rising, fading smoke: buoyancy against flow drag, open sides and
+   * top, lifetimes, ids and ages.
+   */
+  MPCA_PRESET_SMOKE = 0,
+  /**
+   * Water in a box: lively, levelling, and at rest where it lies
+   * (contacts and resting contact), ids.
+   */
+  MPCA_PRESET_WATER = 1,
+  /**
+   * Sand in a box: grains that barely bounce and rest in a pile, ids and
+   * tags.
+   */
+  MPCA_PRESET_SAND = 2,
+};
+#ifndef __cplusplus
+#if __STDC_VERSION__ >= 202311L
+typedef enum mpca_preset mpca_preset;
+#else
+typedef uint32_t mpca_preset;
+#endif // __STDC_VERSION__ >= 202311L
+#endif // __cplusplus
+
+/**
  * An opaque world, reached through its handle: the `mpca_world *` that
  * mpca_world_create or mpca_world_init wrote. A handle is only ever passed
  * back to this library, never dereferenced. (Not `repr(C)`, so cbindgen
@@ -1195,6 +1228,21 @@ mpca_status mpca_desc_defaults(struct mpca_desc *out,
                                uint32_t nx,
                                uint32_t ny,
                                uint32_t nz);
+
+/**
+ * Fills `out` for an effect (`mpca_preset`) in a `dim`-dimensional world
+ * of `nx x ny (x nz)` cells, +y up: its faces, forces and rules, as
+ * docs/model.md's Presets gives them. Room for emitters, obstacles and
+ * bodies is the caller's to add. Sets `struct_size`. An unknown preset is
+ * MPCA_STATUS_BAD_ENUM and leaves `out` as it was; sizes are checked
+ * later, as for mpca_desc_defaults.
+ */
+mpca_status mpca_desc_preset(struct mpca_desc *out,
+                             uint32_t preset,
+                             uint32_t dim,
+                             uint32_t nx,
+                             uint32_t ny,
+                             uint32_t nz);
 
 /**
  * Checks a description in full without building anything.

@@ -84,6 +84,14 @@ inline mpca_desc desc_3d(std::uint32_t nx, std::uint32_t ny, std::uint32_t nz) {
     return d;
 }
 
+/** mpca_desc_preset: a world of nx x ny cells (nz > 0: nx x ny x nz) set
+ * up for an effect, MPCA_PRESET_SMOKE, _WATER or _SAND. */
+inline mpca_desc preset(mpca_preset effect, std::uint32_t nx, std::uint32_t ny, std::uint32_t nz = 0) {
+    mpca_desc d;
+    check(mpca_desc_preset(&d, effect, nz > 0 ? 3 : 2, nx, ny, nz));
+    return d;
+}
+
 /** Checks a description in full, as mpca_world_create will (mpca_desc_validate). */
 inline void validate(const mpca_desc &desc) { check(mpca_desc_validate(&desc)); }
 

@@ -1,6 +1,6 @@
 //! `mpca_desc`: the scene description (M9), as C sees it.
 
-use mpca_core::{Boundary, Collisions, Description, Drag, Drift, Forces, Identity, Method, Quantization, Vortex};
+use mpca_core::{Boundary, Collisions, Description, Drag, Drift, Forces, Identity, Method, Preset, Quantization, Vortex};
 
 use crate::{check_size, guard, mpca_status};
 
@@ -358,6 +358,43 @@ pub unsafe extern "C" fn mpca_desc_defaults(out: *mut mpca_desc, dim: u32, nx: u
         desc.dim = dim;
         desc.size = [nx, ny, if dim == 3 { nz } else { 1 }];
         out.set(desc);
+        Ok(())
+    })
+}
+
+/// An effect a description can start from: values of mpca_desc_preset's
+/// `preset`.
+#[repr(u32)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum mpca_preset {
+    /// Rising, fading smoke: buoyancy against flow drag, open sides and
+    /// top, lifetimes, ids and ages.
+    Smoke = 0,
+    /// Water in a box: lively, levelling, and at rest where it lies
+    /// (contacts and resting contact), ids.
+    Water = 1,
+    /// Sand in a box: grains that barely bounce and rest in a pile, ids and
+    /// tags.
+    Sand = 2,
+}
+
+/// Fills `out` for an effect (`mpca_preset`) in a `dim`-dimensional world
+/// of `nx x ny (x nz)` cells, +y up: its faces, forces and rules, as
+/// docs/model.md's Presets gives them. Room for emitters, obstacles and
+/// bodies is the caller's to add. Sets `struct_size`. An unknown preset is
+/// MPCA_STATUS_BAD_ENUM and leaves `out` as it was; sizes are checked
+/// later, as for mpca_desc_defaults.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mpca_desc_preset(out: *mut mpca_desc, preset: u32, dim: u32, nx: u32, ny: u32, nz: u32) -> mpca_status {
+    guard(|c| {
+        let out = c.out(out)?;
+        let preset = match preset {
+            0 => Preset::Smoke,
+            1 => Preset::Water,
+            2 => Preset::Sand,
+            _ => return Err(mpca_status::BadEnum),
+        };
+        out.set(mpca_desc::from_core(&Description::preset(preset, dim, [nx, ny, if dim == 3 { nz } else { 1 }])));
         Ok(())
     })
 }

@@ -35,6 +35,7 @@ static const struct symbol {
     SYMBOL(mpca_debug_panic),
 #endif
     SYMBOL(mpca_desc_defaults),
+    SYMBOL(mpca_desc_preset),
     SYMBOL(mpca_desc_validate),
     SYMBOL(mpca_world_bytes),
     SYMBOL(mpca_world_add_emitter),

@@ -582,6 +582,7 @@ static void every_function() {
     WRAPS(mpca_version, &mpca::version);
     WRAPS(mpca_desc_defaults, &mpca::desc_2d);
     WRAPS(mpca_desc_defaults, &mpca::desc_3d);
+    WRAPS(mpca_desc_preset, &mpca::preset);
     WRAPS(mpca_desc_validate, &mpca::validate);
     WRAPS(mpca_desc_from_image, &mpca::desc_from_image);
     WRAPS_CONSTRUCTOR(mpca_status_message, mpca::error, mpca_status);

@@ -450,6 +450,19 @@ static void description_cases(void) {
     size_t bytes = SENTINEL_SIZE;
     mpca_world *w = NULL;
     REFUSED(MPCA_STATUS_NULL_POINTER, mpca_desc_defaults(NULL, 2, 8, 8, 0));
+    REFUSED(MPCA_STATUS_NULL_POINTER, mpca_desc_preset(NULL, MPCA_PRESET_WATER, 2, 8, 8, 0));
+    {
+        /* An unknown preset leaves the description as it was. */
+        mpca_desc kept = d;
+        REFUSED(MPCA_STATUS_BAD_ENUM, mpca_desc_preset(&d, 3, 2, 8, 8, 0));
+        REFUSED(MPCA_STATUS_BAD_ENUM, mpca_desc_preset(&d, UINT32_MAX, 3, 8, 8, 8));
+        CHECK(memcmp(&kept, &d, sizeof d) == 0);
+        for (uint32_t p = MPCA_PRESET_SMOKE; p <= MPCA_PRESET_SAND; p++) {
+            mpca_desc preset;
+            CHECK_OK(mpca_desc_preset(&preset, p, 3, 8, 8, 8));
+            CHECK_OK(mpca_desc_validate(&preset));
+        }
+    }
     REFUSED(MPCA_STATUS_NULL_POINTER, mpca_desc_validate(NULL));
     REFUSED(MPCA_STATUS_NULL_POINTER, mpca_world_bytes(NULL, &bytes));
     REFUSED(MPCA_STATUS_NULL_POINTER, mpca_world_bytes(&d, NULL));

@@ -3,7 +3,7 @@
 
 use std::collections::HashMap;
 
-use mpca::{Boundary, Description, Identity, World, WorldBox};
+use mpca::{Boundary, Description, Identity, Preset, World, WorldBox};
 
 /// What a settled pile does over a window of steps: its mean speed at the
 /// end (cells a step), the share of its particles that change cell in a
@@ -125,3 +125,18 @@ fn free_flight_and_fast_bounces_are_unchanged() {
 }
 
 
+
+/// The presets (docs/model.md, Presets) describe valid worlds in 2D and 3D,
+/// with the rules the page gives: the water and the sand rest (M5.7b).
+#[test]
+fn presets_are_valid_and_rest_where_they_should() {
+    for preset in [Preset::Smoke, Preset::Water, Preset::Sand] {
+        for (dim, size) in [(2, [64, 48, 1]), (3, [16, 16, 16])] {
+            let d = Description::preset(preset, dim, size);
+            assert_eq!(d.validate(), Ok(()), "{preset:?} {dim}D");
+            assert_eq!((d.dim, d.size), (dim, size));
+            assert_eq!(d.rest, preset != Preset::Smoke, "{preset:?}");
+            assert!(d.gravity[1] > 0.0 || preset != Preset::Smoke, "smoke rises");
+        }
+    }
+}

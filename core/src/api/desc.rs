@@ -186,6 +186,18 @@ impl core::ops::BitOr for Identity {
     }
 }
 
+/// An effect a description can start from ([`Description::preset`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[non_exhaustive]
+pub enum Preset {
+    /// Rising, fading smoke: buoyancy against flow drag, open sides and top.
+    Smoke,
+    /// Water in a box: lively, levelling, and at rest where it lies.
+    Water,
+    /// Sand in a box: grains that barely bounce and rest in a pile.
+    Sand,
+}
+
 /// Everything a world is built from. Start from [`Description::new_2d`] or
 /// [`Description::new_3d`] and change the fields a scene needs.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -315,6 +327,50 @@ impl Description {
         let mut d = Self::new_2d(nx, ny);
         d.dim = 3;
         d.size[2] = nz;
+        d
+    }
+
+    /// A `dim`-dimensional world of `size` cells (the third ignored in 2D)
+    /// set up for an effect: its faces, forces and rules, with +y up
+    /// (docs/model.md, Presets, says what each sets and why). Room for
+    /// emitters, obstacles and bodies is the caller's to add.
+    pub const fn preset(preset: Preset, dim: u32, size: [u32; 3]) -> Self {
+        let mut d = if dim == 3 { Self::new_3d(size[0], size[1], size[2]) } else { Self::new_2d(size[0], size[1]) };
+        d.dim = dim;
+        d.boundary = [[Boundary::Wall; 2]; 3];
+        d.forces.uniform = true;
+        d.contacts = true;
+        match preset {
+            Preset::Smoke => {
+                // Rises from a floor through open sides and top, at the
+                // speed buoyancy and drag settle on, and fades.
+                d.boundary = [[Boundary::Open; 2]; 3];
+                d.boundary[1][0] = Boundary::Wall;
+                d.gravity = [0.0, 0.0069, 0.0];
+                d.drag.rate = 0.033;
+                d.collisions = Collisions::SpeedLimited;
+                d.contacts = false;
+                d.lifetimes = true;
+                d.identity = Identity(Identity::IDS.0 | Identity::AGES.0);
+            }
+            Preset::Water => {
+                // Lively where it falls, levelled by its bounces, at rest
+                // where it lies.
+                d.gravity = [0.0, -0.005, 0.0];
+                d.restitution = 0.95;
+                d.wall_restitution = 0.95;
+                d.rest = true;
+                d.identity = Identity::IDS;
+            }
+            Preset::Sand => {
+                // Grains that barely bounce and come to rest in a pile.
+                d.gravity = [0.0, -0.0136, 0.0];
+                d.restitution = 0.1;
+                d.wall_restitution = 0.1;
+                d.rest = true;
+                d.identity = Identity(Identity::IDS.0 | Identity::TAGS.0);
+            }
+        }
         d
     }
 
