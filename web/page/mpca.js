@@ -23,11 +23,27 @@ class Mpca {
         this.size = exports.mpca_web_size();
     }
 
-    // Builds scene `kind` (SMOKE or WATER) with `seed`; throws if refused.
+    // Builds scene `kind` (SMOKE or WATER) with `seed`; throws if refused,
+    // saying why (lastError).
     scene(kind, seed) {
         const status = this.x.mpca_web_init(kind, seed >>> 0);
-        if (status !== 0) throw new Error(`mpca: scene ${kind} refused, status ${status}`);
+        if (status !== 0) throw new Error(`mpca: scene ${kind} refused, status ${status}: ${this.lastError()}`);
         return new Scene(this, kind);
+    }
+
+    // Why the last call was refused: the kind of problem, then the field
+    // or part at fault ("the emitter table is full: desc.emitter_capacity");
+    // "" while none was.
+    lastError() {
+        const [message, detail] = [0, 1].map((part) => this.text(this.x.mpca_web_error(part)));
+        return detail && detail !== message ? `${message}: ${detail}` : message;
+    }
+
+    // The NUL-terminated text at `at` in the module's memory ("" for 0).
+    text(at) {
+        if (at === 0) return '';
+        const bytes = new Uint8Array(this.x.memory.buffer, at);
+        return new TextDecoder().decode(bytes.subarray(0, bytes.indexOf(0)));
     }
 }
 
@@ -50,7 +66,8 @@ class Scene {
         return this.m.x.mpca_web_particles(this.kind);
     }
 
-    // An emitter at cell (x, y), y up; false when the table is full.
+    // An emitter at cell (x, y), y up; false when the table is full (why:
+    // lastError of the module).
     emit(x, y) {
         return this.m.x.mpca_web_emit(this.kind, x, y) === 0;
     }
