@@ -14,6 +14,9 @@
 //! - **Bad values** (NaN, infinities, out-of-range numbers, unknown enum
 //!   values, wrong `struct_size`) return a status and leave the world
 //!   unchanged.
+//! - **Details**: every refusal also leaves a detail that names the field,
+//!   argument or part at fault, for the thread (mpca_last_error) and the
+//!   world called (mpca_world_last_error): `last_error.rs`.
 //! - **Panics** never unwind into C. No input is meant to panic: a panic is
 //!   a bug (fuzzing has found none since the checked accessors). The
 //!   default build, like a C library whose `assert` fails, writes one line

@@ -24,23 +24,18 @@ class Mpca {
     }
 
     // Builds scene `kind` (SMOKE or WATER) with `seed`; throws if refused,
-    // saying why (lastError).
+    // with the status (mpca_status's number) and the field or part at fault.
     scene(kind, seed) {
         const status = this.x.mpca_web_init(kind, seed >>> 0);
         if (status !== 0) throw new Error(`mpca: scene ${kind} refused, status ${status}: ${this.lastError()}`);
         return new Scene(this, kind);
     }
 
-    // Why the last call was refused: the kind of problem, then the field
-    // or part at fault ("the emitter table is full: desc.emitter_capacity");
-    // "" while none was.
+    // The field or part at fault in the last refused call
+    // ("desc.emitter_capacity"), "" while none was: static text in the
+    // module's memory, read up to its NUL.
     lastError() {
-        const [message, detail] = [0, 1].map((part) => this.text(this.x.mpca_web_error(part)));
-        return detail && detail !== message ? `${message}: ${detail}` : message;
-    }
-
-    // The NUL-terminated text at `at` in the module's memory ("" for 0).
-    text(at) {
+        const at = this.x.mpca_web_error();
         if (at === 0) return '';
         const bytes = new Uint8Array(this.x.memory.buffer, at);
         return new TextDecoder().decode(bytes.subarray(0, bytes.indexOf(0)));

@@ -55,16 +55,13 @@ fn refused(e: Error) -> u32 {
     e.code()
 }
 
-/// The last refusal's text, `part` 0 its kind's message and 1 its detail
-/// (the field or part at fault): the address of static, NUL-terminated
-/// text in the module's memory, or 0 while no export was refused.
+/// The detail of the last refusal (the field or part at fault, beside
+/// the code the export returned): the address of static, NUL-terminated
+/// text in the module's memory, or 0 while no export was refused. The
+/// kinds' messages are left out of the module: the code says the kind.
 #[unsafe(no_mangle)]
-pub extern "C" fn mpca_web_error(part: u32) -> *const u8 {
-    match LAST.0.get() {
-        Some(e) if part == 0 => e.kind().c_message().as_ptr().cast(),
-        Some(e) => e.c_detail().as_ptr().cast(),
-        None => core::ptr::null(),
-    }
+pub extern "C" fn mpca_web_error() -> *const u8 {
+    LAST.0.get().map_or(core::ptr::null(), |e| e.c_detail().as_ptr().cast())
 }
 
 /// The world of a slot, if built.

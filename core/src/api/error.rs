@@ -359,7 +359,33 @@ const _: () = {
 
 #[cfg(test)]
 mod tests {
-    use super::ErrorKind;
+    extern crate std;
+
+    use core::ffi::CStr;
+
+    use super::{Error, ErrorKind};
+
+    #[test]
+    fn an_error_is_its_kind_and_its_detail() {
+        // Expect: two errors of one kind are equal where their details are
+        // (not their addresses), of their kind either way; Display is the
+        // kind's message, then the detail (the message alone without
+        // details).
+        let a = Error::new(ErrorKind::NotFinite, c"desc.gravity");
+        let b = Error::new(ErrorKind::NotFinite, c"velocity");
+        let same = Error::new(ErrorKind::NotFinite, CStr::from_bytes_with_nul(b"desc.gravity\0").unwrap());
+        assert!(a == ErrorKind::NotFinite && b == ErrorKind::NotFinite);
+        assert_eq!(a.code(), ErrorKind::NotFinite.code());
+        if cfg!(feature = "details") {
+            assert_ne!(a, b);
+            assert_eq!(a, same);
+            assert_eq!(std::format!("{b}"), "a floating-point input is NaN or infinite: velocity");
+            assert_eq!(b.c_detail(), c"velocity");
+        } else {
+            assert_eq!((a, b.detail()), (same, b.message()));
+            assert_eq!(std::format!("{b}"), b.message());
+        }
+    }
 
     #[test]
     fn numbers_and_messages_are_distinct() {
