@@ -48,7 +48,9 @@ pub struct mpca_shape {
 
 impl mpca_shape {
     /// The core's shape; a wrong `struct_size` or an unknown kind is
-    /// refused here, the geometry by the core.
+    /// refused here, the geometry by the core. Out of line: six exports
+    /// take a shape.
+    #[inline(never)]
     pub(crate) fn to_core(self) -> Result<Shape, Refusal> {
         check_size::<mpca_shape>(self.struct_size, c"shape.struct_size")?;
         Shape::from_parts(self.kind, self.a, self.b, self.radius).ok_or(Refusal::new(mpca_status::BadEnum, c"shape.kind"))
