@@ -373,7 +373,9 @@ mod tests {
         // details).
         let a = Error::new(ErrorKind::NotFinite, c"desc.gravity");
         let b = Error::new(ErrorKind::NotFinite, c"velocity");
-        let same = Error::new(ErrorKind::NotFinite, CStr::from_bytes_with_nul(b"desc.gravity\0").unwrap());
+        // The same text at another address.
+        static GRAVITY: [u8; 13] = *b"desc.gravity\0";
+        let same = Error::new(ErrorKind::NotFinite, CStr::from_bytes_with_nul(&GRAVITY).unwrap());
         assert!(a == ErrorKind::NotFinite && b == ErrorKind::NotFinite);
         assert_eq!(a.code(), ErrorKind::NotFinite.code());
         if cfg!(feature = "details") {
