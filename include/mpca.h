@@ -6,7 +6,10 @@
  * results through out-parameters. NULL pointers, dead or forged handles
  * (firmware builds: within the limits stated at mpca_world), NaN and
  * out-of-range values are refused with a status and change nothing.
- * mpca_status_message() turns a status into a static string.
+ * mpca_status_message() turns a status into a static string that says
+ * what kind of problem it is; mpca_last_error() (this thread's last
+ * refusal) and mpca_world_last_error() (a world's last call) name where it
+ * is: the field, argument or part at fault ("desc.size[1]").
  *
  * Panics: no input is meant to cause one; one would be a bug. The library
  * then writes one line on stderr ("mpca: panicked at FILE:LINE:COL: ...")
@@ -1348,6 +1351,43 @@ mpca_status mpca_world_set_cell_wind(struct mpca_world *world,
                                      const float *wind);
 
 /**
+ * The detail of this thread's last refused call, from any function of the
+ * library (a description's check, a world's creation, a call on any
+ * world): where the problem is, as the field, argument or part at fault,
+ * with what is wrong with it where the status does not say:
+ * `desc.size[1]`, `velocity`, `desc.emitter_capacity is 0`, `checksum`
+ * (of an image). Fields are named as the Rust crate's description names
+ * them, which mpca_desc follows with `_` for `.` (`desc.drag.rate` is
+ * `drag_rate`); arguments by their names in this header. A status that
+ * says all there is (a NULL pointer, MPCA_STATUS_BUSY) has its message as
+ * the detail. "" while no call of this thread was refused. A call that
+ * succeeds does not clear it: ask after a status other than
+ * `MPCA_STATUS_OK`, as with `errno`, and print it after
+ * mpca_status_message(status): "a world size is odd; Margolus blocks need
+ * even sizes: desc.size[1]". Never NULL; static text, never to be freed, valid for the library's
+ * life. Firmware builds (without the `hosted` feature) have no threads:
+ * one record for the whole library. A library built without the feature
+ * `details` gives the status's message as every detail.
+ */
+const char *mpca_last_error(void);
+
+/**
+ * The detail of the last call on `world`, if it was refused, as
+ * mpca_last_error gives it; "" if that call succeeded or no call was made
+ * on the world yet. The last call is the last to enter the world: every
+ * call taking it but those refused before reaching it (a NULL or dead
+ * handle, MPCA_STATUS_BUSY) and mpca_world_step_task, whose refusals
+ * only mpca_last_error records. Calls that only read the world
+ * (`const mpca_world *`) count too, so with several threads on one world
+ * the answer is the last of theirs to end. Never NULL; static text, never
+ * to be freed. A NULL or dead handle gets a detail saying so.
+ *
+ * Firmware builds keep one record for the library (no registry knows the
+ * worlds): the answer is mpca_last_error's, whatever `world`.
+ */
+const char *mpca_world_last_error(const struct mpca_world *world);
+
+/**
  * The surface entries `shape` takes as the first obstacle of a world of
  * `desc`, into `out_entries`: the `surface_capacity` it needs, asked before
  * the world is made. A world of several shapes needs at most the sum of
@@ -1663,8 +1703,9 @@ mpca_status mpca_world_init_from_image(const void *image,
                                        struct mpca_world **out_world);
 
 /**
- * A static, NUL-terminated English message for `status`; never NULL, never
- * to be freed. Values that are not statuses get a message saying so.
+ * A static, NUL-terminated English message for `status`: what kind of
+ * problem it is (mpca_last_error says where); never NULL, never to be
+ * freed. Values that are not statuses get a message saying so.
  */
 const char *mpca_status_message(uint32_t status);
 

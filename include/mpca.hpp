@@ -11,9 +11,11 @@
  *   the library) and destroys it in its destructor. It moves and does not
  *   copy; a moved-from world is empty, and calls on it throw the status
  *   MPCA_STATUS_NULL_POINTER.
- * - Every refusal throws mpca::error, which carries the mpca_status and
- *   mpca_status_message's text as what(). The world is unchanged then, as
- *   the C ABI promises.
+ * - Every refusal throws mpca::error, which carries the mpca_status, the
+ *   detail that names the field or part at fault (mpca_last_error's text,
+ *   as detail()), and both as what(): "a world size is odd; Margolus blocks
+ *   need even sizes: desc.size[1]". The world is unchanged then, as the C
+ *   ABI promises.
  * - Exports come back as std::vector, or go into the caller's buffer
  *   (export_positions and its twins, for a mapped vertex buffer).
  * - step_parallel takes any callable host, a lambda or a std::function,
@@ -36,6 +38,7 @@
 #include <limits>
 #include <memory>
 #include <stdexcept>
+#include <string>
 #include <type_traits>
 #include <vector>
 
@@ -43,16 +46,39 @@
 
 namespace mpca {
 
-/** A call the library refused: its status and that status's message. */
+/** A call the library refused: its status, that status's message and the
+ * detail naming where the problem is. */
 class error : public std::runtime_error {
 public:
-    explicit error(mpca_status status) : std::runtime_error(mpca_status_message(status)), status_(status) {}
+    /** The refusal of the call this thread just made: `status`, and
+     * mpca_last_error's detail. */
+    explicit error(mpca_status status) : error(status, mpca_last_error()) {}
+
+    /** A refusal with a detail of the caller's (static text). */
+    error(mpca_status status, const char *detail)
+        : std::runtime_error(text(status, detail)), status_(status), detail_(detail) {}
 
     /** The status the C function returned. */
     mpca_status status() const noexcept { return status_; }
 
+    /** The field, argument or part at fault ("desc.size[1]"): static
+     * text, never freed. */
+    const char *detail() const noexcept { return detail_; }
+
 private:
+    /** what(): the status's message, then the detail where it says more
+     * (a status without a detail of its own has its message as one). */
+    static std::string text(mpca_status status, const char *detail) {
+        std::string t = mpca_status_message(status);
+        if (detail != nullptr && *detail != '\0' && t != detail) {
+            t += ": ";
+            t += detail;
+        }
+        return t;
+    }
+
     mpca_status status_;
+    const char *detail_;
 };
 
 /** Throws mpca::error unless `status` is MPCA_STATUS_OK. */
@@ -64,6 +90,10 @@ inline void check(mpca_status status) {
 
 /** The library's version, "MAJOR.MINOR.PATCH". */
 inline const char *version() noexcept { return mpca_version(); }
+
+/** The detail of this thread's last refusal (mpca_last_error); "" while
+ * none. mpca::error carries it already. */
+inline const char *last_error() noexcept { return mpca_last_error(); }
 
 /** Cell coordinates (the third 0 in 2D). */
 typedef std::array<std::uint32_t, 3> cell_pos;
@@ -245,6 +275,10 @@ public:
     /** The handle, for the functions of mpca.h this class does not wrap;
      * still owned by this object. NULL when empty. */
     mpca_world *get() const noexcept { return w_; }
+
+    /** The detail of this world's last call if it was refused, "" if it
+     * succeeded (mpca_world_last_error). */
+    const char *last_error() const noexcept { return mpca_world_last_error(w_); }
 
     /** Whether this object holds a world (it does until moved from or reset). */
     explicit operator bool() const noexcept { return w_ != nullptr; }
@@ -624,7 +658,7 @@ private:
         std::size_t n = 1;
         for (std::size_t i = 0; i < 3; i++) {
             if (res[i] != 0 && n > std::numeric_limits<std::size_t>::max() / res[i]) {
-                throw error(MPCA_STATUS_BAD_RESOLUTION);
+                throw error(MPCA_STATUS_BAD_RESOLUTION, "res: more bins than a size_t counts");
             }
             n *= res[i];
         }

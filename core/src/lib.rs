@@ -21,7 +21,7 @@ pub use rules::{assign, rng};
 pub use api::port;
 pub use assign::Method;
 pub use api::desc::{Boundary, Collisions, Description, Drag, Drift, Forces, Identity, Preset, Quantization, Vortex};
-pub use api::error::Error;
+pub use api::error::{Error, ErrorKind};
 #[cfg(feature = "alloc")]
 pub use api::owned::WorldBox;
 pub use api::query::{Cell, Particle, Particles, RegionStats, Stats};

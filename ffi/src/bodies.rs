@@ -111,7 +111,7 @@ pub unsafe extern "C" fn mpca_world_body_stats(world: *const mpca_world, id: u32
         let w = c.world_ref(world)?;
         // The caller set the leading struct_size; the rest may be anything.
         let size = *c.get(out.cast_const().cast::<u32>())?;
-        check_size::<mpca_body_stats>(size)?;
+        check_size::<mpca_body_stats>(size, c"out->struct_size")?;
         #[cfg(feature = "obstacles")]
         {
             let s = w.body_stats(id)?;

@@ -15,7 +15,8 @@
 //!
 //! Handles are not caller memory: [`Call::world`] resolves one through the
 //! registry of `handle.rs` before anything is read, and enters the world
-//! there for as long as the call runs (the `Call` leaves it when dropped).
+//! there for as long as the call runs (the `Call` leaves it when it ends,
+//! recording the call's detail for the world: `last_error.rs`).
 
 #[cfg(feature = "hosted")]
 use core::cell::Cell;
@@ -24,6 +25,7 @@ use core::marker::PhantomData;
 use mpca_core::World;
 
 use crate::handle::{self, Access};
+use crate::last_error::{self, Refusal};
 use crate::{mpca_status, mpca_world};
 
 /// One call of an export and its caller's promise (module docs). Only
@@ -34,50 +36,84 @@ pub(crate) struct Call<'c> {
     /// on the caller's thread, for this call.
     _call: PhantomData<*mut &'c ()>,
     /// The world this call entered in the registry, and for what; left
-    /// when the call ends. Firmware builds have no registry to leave.
+    /// when the call ends, its detail recorded. Firmware builds have no
+    /// registry to leave, nor a record per world.
     #[cfg(feature = "hosted")]
     entered: Cell<Option<(*const mpca_world, Access)>>,
+}
+
+impl Call<'_> {
+    /// The call ends with `result`: the world it entered records it and
+    /// is left, the thread records a refusal, and the status comes back.
+    /// Out of line: every export ends here.
+    #[inline(never)]
+    fn finish(self, result: Result<(), Refusal>) -> mpca_status {
+        match result {
+            Ok(()) => {
+                #[cfg(feature = "hosted")]
+                self.end(None);
+                mpca_status::Ok
+            }
+            Err(r) => {
+                #[cfg(feature = "hosted")]
+                self.end(Some(r));
+                last_error::refused(r);
+                r.status
+            }
+        }
+    }
+
+    /// The call ends with refusal `r` (`None`: success): the world it
+    /// entered records it, and is left.
+    #[cfg(feature = "hosted")]
+    fn end(&self, r: Option<Refusal>) {
+        if let Some((w, access)) = self.entered.take() {
+            handle::leave(w, access, r.map_or(core::ptr::null(), Refusal::text));
+        }
+    }
 }
 
 #[cfg(feature = "hosted")]
 impl Drop for Call<'_> {
     /// The call is over (returned, or unwinding to the panic boundary): no
-    /// reference it handed out is used any more.
+    /// reference it handed out is used any more. One that unwound records
+    /// the panic's message.
     fn drop(&mut self) {
-        if let Some((w, access)) = self.entered.take() {
-            handle::leave(w, access);
-        }
+        self.end(Some(Refusal::from(mpca_status::Panic)));
     }
 }
 
 /// Runs an export's body with the caller's promise, inside the panic
-/// boundary where there is one (`catch-panics`; lib.rs), and turns its
-/// result into a status.
+/// boundary where there is one (`catch-panics`; lib.rs), records a
+/// refusal's detail for the thread and the world, and turns its result
+/// into a status.
 ///
 /// Called only as the whole body of an export (a `pub extern "C" fn` of
 /// this crate): that is what makes the [`Call`] it hands out true. The
 /// test `guard_is_called_only_by_exports` below checks the sources for it.
 #[inline]
-pub(crate) fn guard(body: impl for<'c> FnOnce(&Call<'c>) -> Result<(), mpca_status>) -> mpca_status {
+pub(crate) fn guard(body: impl for<'c> FnOnce(&Call<'c>) -> Result<(), Refusal>) -> mpca_status {
     let call = Call {
         _call: PhantomData,
         #[cfg(feature = "hosted")]
         entered: Cell::new(None),
     };
     // The closure owns the call, so it is dropped (its world left) when the
-    // body returns or unwinds.
-    let body = move || body(&call);
+    // body unwinds, and finished when it returns.
+    let body = move || {
+        let result = body(&call);
+        call.finish(result)
+    };
     #[cfg(feature = "catch-panics")]
-    let result = match std::panic::catch_unwind(core::panic::AssertUnwindSafe(body)) {
-        Ok(r) => r,
-        Err(_) => Err(mpca_status::Panic),
+    return match std::panic::catch_unwind(core::panic::AssertUnwindSafe(body)) {
+        Ok(status) => status,
+        Err(_) => {
+            last_error::refused(Refusal::from(mpca_status::Panic));
+            mpca_status::Panic
+        }
     };
     #[cfg(not(feature = "catch-panics"))]
-    let result = body();
-    match result {
-        Ok(()) => mpca_status::Ok,
-        Err(s) => s,
-    }
+    body()
 }
 
 /// Whether `len` values of `T` fit in one object: at most `isize::MAX`
@@ -190,7 +226,7 @@ impl<'c> Call<'c> {
 
     /// The world behind a handle, for a call that changes it.
     #[inline]
-    pub(crate) fn world(&self, w: *mut mpca_world) -> Result<&'c mut World, mpca_status> {
+    pub(crate) fn world(&self, w: *mut mpca_world) -> Result<&'c mut World, Refusal> {
         let at = self.world_at(w, Access::Write)?;
         // SAFETY: entered for Write (`world_at`): the registry lets no other
         // call inside until this one ends, which `'c` does not outlive
@@ -201,7 +237,7 @@ impl<'c> Call<'c> {
     /// The world behind a handle, for a call that ends or replaces it
     /// (deinit, load): refused with `Busy` while any call is inside.
     #[inline]
-    pub(crate) fn world_to_end(&self, w: *mut mpca_world) -> Result<&'c mut World, mpca_status> {
+    pub(crate) fn world_to_end(&self, w: *mut mpca_world) -> Result<&'c mut World, Refusal> {
         let at = self.world_at(w, Access::End)?;
         // SAFETY: as in `world`; End admits no other call either.
         Ok(unsafe { &mut *at })
@@ -210,7 +246,7 @@ impl<'c> Call<'c> {
     /// The world behind a handle, for a call that only reads it: others
     /// may read it at the same time, none change it.
     #[inline]
-    pub(crate) fn world_ref(&self, w: *const mpca_world) -> Result<&'c World, mpca_status> {
+    pub(crate) fn world_ref(&self, w: *const mpca_world) -> Result<&'c World, Refusal> {
         let at = self.world_at(w, Access::Read)?;
         // SAFETY: entered for Read: while this call runs the registry lets
         // only calls that read the world inside, and they hold shared
@@ -221,7 +257,7 @@ impl<'c> Call<'c> {
     /// Enters the world behind a handle for `access` and finds it. One
     /// function behind the three above, so each export's call is small.
     #[inline(never)]
-    fn world_at(&self, w: *const mpca_world, access: Access) -> Result<*mut World, mpca_status> {
+    fn world_at(&self, w: *const mpca_world, access: Access) -> Result<*mut World, Refusal> {
         let at = self.enter(w, access)?;
         // SAFETY: hosted builds: `at` is where a world was built and
         // registered, and its handle was not revoked since, so the memory
@@ -229,7 +265,7 @@ impl<'c> Call<'c> {
         // stays until deinit). Firmware builds: the C contract that a
         // handle is an address this library returned, still readable.
         // Either way the tag is checked before anything else is read.
-        unsafe { World::from_ptr_raw(at) }.map_err(|_| mpca_status::BadHandle)
+        unsafe { World::from_ptr_raw(at) }.map_err(|e| Refusal::new(mpca_status::BadHandle, e.c_detail()))
     }
 }
 
@@ -248,7 +284,7 @@ mod tests {
             let far = core::ptr::NonNull::<f32>::dangling().as_ptr();
             assert_eq!(c.slice(far.cast_const(), usize::MAX / 2, mpca_status::BadLength).err(), Some(mpca_status::BadLength));
             assert_eq!(c.slice_mut(far, usize::MAX / 4 + 1, mpca_status::BadResolution).err(), Some(mpca_status::BadResolution));
-            assert_eq!(c.world(core::ptr::null_mut()).err(), Some(mpca_status::NullPointer));
+            assert_eq!(c.world(core::ptr::null_mut()).err().map(|r| r.status), Some(mpca_status::NullPointer));
             Ok(())
         });
         assert_eq!(status, mpca_status::Ok);
@@ -348,14 +384,17 @@ mod tests {
     }
 
     /// `guard`'s promise is true only where C called: every use of it must
-    /// be the body of an export. And every export but two that only look
-    /// up static strings runs inside it, the panic boundary.
+    /// be the body of an export. And every export but four that only look
+    /// up static strings runs inside it, the panic boundary (the last
+    /// error's two must not be calls that record one).
     #[test]
     fn guard_is_called_only_by_exports() {
         let sources = [
+            ("bodies.rs", include_str!("bodies.rs")),
             ("desc.rs", include_str!("desc.rs")),
             ("emitters.rs", include_str!("emitters.rs")),
             ("forces.rs", include_str!("forces.rs")),
+            ("last_error.rs", include_str!("last_error.rs")),
             ("lib.rs", include_str!("lib.rs")),
             ("obstacles.rs", include_str!("obstacles.rs")),
             ("parallel.rs", include_str!("parallel.rs")),
@@ -382,7 +421,7 @@ mod tests {
                 }
             }
         }
-        let expected = std::collections::BTreeSet::from(["mpca_version", "mpca_status_message"]);
+        let expected = std::collections::BTreeSet::from(["mpca_version", "mpca_status_message", "mpca_last_error", "mpca_world_last_error"]);
         assert_eq!(unguarded, expected, "exports outside the panic boundary");
     }
 }

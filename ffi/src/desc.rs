@@ -2,7 +2,9 @@
 
 use mpca_core::{Boundary, Collisions, Description, Drag, Drift, Forces, Identity, Method, Preset, Quantization, Vortex};
 
-use crate::{check_size, guard, mpca_status};
+use core::ffi::CStr;
+
+use crate::{check_size, guard, mpca_status, Refusal};
 
 /// What happens at one face of the domain (M4). Values of `mpca_desc.boundary`.
 #[repr(u32)]
@@ -205,12 +207,12 @@ const fn boundary_to_c(b: Boundary) -> u32 {
     }
 }
 
-fn boundary_from_c(v: u32) -> Result<Boundary, mpca_status> {
+fn boundary_from_c(v: u32) -> Result<Boundary, Refusal> {
     Ok(match v {
         0 => Boundary::Periodic,
         1 => Boundary::Wall,
         2 => Boundary::Open,
-        _ => return Err(mpca_status::BadEnum),
+        _ => return Err(Refusal::new(mpca_status::BadEnum, c"desc.boundary")),
     })
 }
 
@@ -270,8 +272,8 @@ impl mpca_desc {
     /// here, everything else by the core's own validation. Out of line:
     /// every export that takes a description calls it.
     #[inline(never)]
-    pub(crate) fn to_core(self) -> Result<Description, mpca_status> {
-        check_size::<mpca_desc>(self.struct_size)?;
+    pub(crate) fn to_core(self) -> Result<Description, Refusal> {
+        check_size::<mpca_desc>(self.struct_size, c"desc.struct_size")?;
         // Every field is set below: the constant only gives the
         // non-exhaustive structure a start.
         let mut d = BASE;
@@ -299,7 +301,7 @@ impl mpca_desc {
         d.drag = Drag { rate: self.drag_rate, wind: self.drag_wind, field: one(self.drag_wind_field), vortex: one(self.drag_vortex) };
         d.lifetimes = one(self.lifetimes);
         if ones > 1 || self.forces & !FORCE_BITS != 0 || self.identity > Identity::ALL.bits() || self.reserved != 0 {
-            return Err(mpca_status::BadEnum);
+            return Err(Refusal::computed(mpca_status::BadEnum, || self.bad_flag()));
         }
         // The core's flags are the C ABI's bits (checked at the top).
         d.identity = Identity::from_bits(self.identity).unwrap_or_default();
@@ -330,16 +332,50 @@ impl mpca_desc {
         d.quantization = match self.quantization {
             8 => Quantization::Bits8,
             16 => Quantization::Bits16,
-            _ => return Err(mpca_status::BadEnum),
+            _ => return Err(Refusal::new(mpca_status::BadEnum, c"desc.quantization")),
         };
         d.method = match self.method {
             0 => Method::Exhaustive,
             1 => Method::ExactFast,
             2 => Method::Greedy,
-            _ => return Err(mpca_status::BadEnum),
+            _ => return Err(Refusal::new(mpca_status::BadEnum, c"desc.method")),
         };
         d.emitter_capacity = self.emitter_capacity;
         Ok(d)
+    }
+
+    /// The field [`mpca_desc::to_core`]'s test of the flags and bits
+    /// refused, asked only then, so that the test stays one.
+    #[cold]
+    #[inline(never)]
+    fn bad_flag(&self) -> &'static CStr {
+        if self.per_particle_mass > 1 {
+            c"desc.per_particle_mass"
+        } else if self.obstacles > 1 {
+            c"desc.obstacles"
+        } else if self.drift > 1 {
+            c"desc.drift"
+        } else if self.collisions > 1 {
+            c"desc.collisions"
+        } else if self.contacts > 1 {
+            c"desc.contacts"
+        } else if self.rest > 1 {
+            c"desc.rest"
+        } else if self.energy_neutral > 1 {
+            c"desc.energy_neutral"
+        } else if self.drag_wind_field > 1 {
+            c"desc.drag_wind_field"
+        } else if self.drag_vortex > 1 {
+            c"desc.drag_vortex"
+        } else if self.lifetimes > 1 {
+            c"desc.lifetimes"
+        } else if self.forces & !FORCE_BITS != 0 {
+            c"desc.forces"
+        } else if self.reserved != 0 {
+            c"desc.reserved"
+        } else {
+            c"desc.identity"
+        }
     }
 }
 
@@ -392,7 +428,7 @@ pub unsafe extern "C" fn mpca_desc_preset(out: *mut mpca_desc, preset: u32, dim:
             0 => Preset::Smoke,
             1 => Preset::Water,
             2 => Preset::Sand,
-            _ => return Err(mpca_status::BadEnum),
+            _ => return Err(Refusal::new(mpca_status::BadEnum, c"preset")),
         };
         out.set(mpca_desc::from_core(&Description::preset(preset, dim, [nx, ny, if dim == 3 { nz } else { 1 }])));
         Ok(())
@@ -436,7 +472,7 @@ mod tests {
             // SAFETY: `out` is a valid, writable mpca_desc.
             assert_eq!(unsafe { mpca_desc_defaults(&mut out, dim, 6, 8, 10) }, mpca_status::Ok);
             assert_eq!(out, mpca_desc::from_core(&core), "dim {dim}");
-            assert_eq!(out.to_core(), Ok(core), "dim {dim}");
+            assert_eq!(out.to_core().ok(), Some(core), "dim {dim}");
         }
     }
 }

@@ -38,7 +38,7 @@ pub unsafe extern "C" fn mpca_world_add_emitter(world: *mut mpca_world, emitter:
         let w = c.world(world)?;
         let e = c.get(emitter)?;
         let out = c.out(out_index)?;
-        check_size::<mpca_emitter>(e.struct_size)?;
+        check_size::<mpca_emitter>(e.struct_size, c"emitter.struct_size")?;
         let index = w.add_emitter(Emitter {
             min: e.min,
             max: e.max,

@@ -20,7 +20,7 @@ use mpca_core::World;
 use crate::{mpca_status, mpca_world};
 
 #[cfg(feature = "hosted")]
-pub(crate) use hosted::{claim, close_tasks, enter, issue, issue_owned, leave, open_tasks, reserve, revoke, run_task};
+pub(crate) use hosted::{claim, close_tasks, enter, issue, issue_owned, last_detail, leave, open_tasks, reserve, revoke, run_task};
 
 #[cfg(not(feature = "hosted"))]
 pub(crate) use firmware::{claim, enter, issue, reserve, revoke};
@@ -42,6 +42,7 @@ pub(crate) enum Access {
 #[cfg(feature = "hosted")]
 mod hosted {
     use alloc::vec::Vec;
+    use core::ffi::c_char;
     use core::ptr::NonNull;
 
     use crate::sys::{Held, Lock};
@@ -49,12 +50,15 @@ mod hosted {
     use super::{mpca_status, mpca_world, Access, World};
 
     /// A live world: where it starts, how many bytes it spans, whether the
-    /// library allocated it, and who is inside it.
+    /// library allocated it, who is inside it, and the detail of the last
+    /// call to enter it (NULL: it succeeded, or none was made;
+    /// mpca_world_last_error).
     struct Entry {
         at: NonNull<u8>,
         bytes: usize,
         owned: bool,
         using: Use,
+        last: *const c_char,
     }
 
     impl Entry {
@@ -232,7 +236,7 @@ mod hosted {
     /// its handle. The live worlds that memory held end: their handles are
     /// refused from now on.
     pub(crate) fn issue(number: Reserved, claim: Claim, world: &mut World) -> *mut mpca_world {
-        let entry = Entry { at: NonNull::from(&mut *world).cast(), bytes: world.size_in_bytes(), owned: false, using: Use::Read(0) };
+        let entry = Entry { at: NonNull::from(&mut *world).cast(), bytes: world.size_in_bytes(), owned: false, using: Use::Read(0), last: core::ptr::null() };
         let handle = value(number.0);
         let mut r = registry();
         r.live.0.retain(|(_, e)| !e.overlaps(claim.start, claim.end));
@@ -255,7 +259,7 @@ mod hosted {
         let mut r = registry();
         let start = at.as_ptr() as usize;
         r.live.0.retain(|(_, e)| !e.overlaps(start, start + bytes));
-        r.live.insert(handle, Entry { at, bytes, owned: true, using: Use::Read(0) });
+        r.live.insert(handle, Entry { at, bytes, owned: true, using: Use::Read(0), last: core::ptr::null() });
         core::ptr::without_provenance_mut(handle)
     }
 
@@ -297,11 +301,13 @@ mod hosted {
         }
     }
 
-    /// Ends a call's [`enter`]. A handle the call ended (deinit, destroy)
-    /// is gone from the registry, and nothing is left to do.
+    /// Ends a call's [`enter`], recording its detail (NULL: it succeeded)
+    /// as the world's last. A handle the call ended (deinit, destroy) is
+    /// gone from the registry, and nothing is left to do.
     #[inline(never)]
-    pub(crate) fn leave(handle: *const mpca_world, access: Access) {
+    pub(crate) fn leave(handle: *const mpca_world, access: Access, detail: *const c_char) {
         if let Some(e) = registry().live.get_mut(&handle.addr()) {
+            e.last = detail;
             match (&mut e.using, access) {
                 (Use::Read(n) | Use::Draining(n), Access::Read) => *n = n.saturating_sub(1),
                 (Use::Write, Access::Write | Access::End) => e.using = Use::Read(0),
@@ -384,6 +390,14 @@ mod hosted {
         Ok(())
     }
 
+    /// The detail of the last call to enter the world of `handle` (NULL:
+    /// it succeeded, or none was made); `None` for a handle that is not
+    /// live. It does not enter the world, so it answers during a parallel
+    /// step too.
+    pub(crate) fn last_detail(handle: *const mpca_world) -> Option<*const c_char> {
+        registry().live.get_mut(&handle.addr()).map(|e| e.last)
+    }
+
     /// Ends a handle: it is refused from now on. Called by the call that
     /// holds the world for `Write`, so no other call is inside it.
     pub(crate) fn revoke(handle: *const mpca_world) {
@@ -420,7 +434,7 @@ mod hosted {
                 assert!(matches!(claim(at, bytes), Err(mpca_status::Busy)));
                 assert_eq!(enter(owned, Access::End).err(), Some(mpca_status::Busy));
                 assert_eq!(mpca_world_destroy(owned), mpca_status::Busy);
-                leave(owned, Access::Read);
+                leave(owned, Access::Read, core::ptr::null());
                 assert_eq!(mpca_world_destroy(owned), mpca_status::Ok);
 
                 // Caller memory: a claim holds the world in it, refusing its
@@ -432,7 +446,7 @@ mod hosted {
                 assert_eq!(enter(w, Access::Read).err(), Some(mpca_status::Busy));
                 drop(claimed);
                 assert!(enter(w, Access::Read).is_ok());
-                leave(w, Access::Read);
+                leave(w, Access::Read, core::ptr::null());
                 assert_eq!(mpca_world_deinit(w), mpca_status::Ok);
             }
         }

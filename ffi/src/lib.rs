@@ -14,6 +14,9 @@
 //! - **Bad values** (NaN, infinities, out-of-range numbers, unknown enum
 //!   values, wrong `struct_size`) return a status and leave the world
 //!   unchanged.
+//! - **Details**: every refusal also leaves a detail that names the field,
+//!   argument or part at fault, for the thread (mpca_last_error) and the
+//!   world called (mpca_world_last_error): `last_error.rs`.
 //! - **Panics** never unwind into C. No input is meant to panic: a panic is
 //!   a bug (fuzzing has found none since the checked accessors). The
 //!   default build, like a C library whose `assert` fails, writes one line
@@ -56,6 +59,7 @@ mod desc;
 mod emitters;
 mod forces;
 mod handle;
+mod last_error;
 mod obstacles;
 #[cfg(feature = "hosted")]
 mod parallel;
@@ -73,6 +77,8 @@ pub use bodies::*;
 pub use desc::*;
 pub use emitters::*;
 pub use forces::*;
+pub use last_error::{mpca_last_error, mpca_world_last_error};
+pub(crate) use last_error::Refusal;
 pub use obstacles::*;
 #[cfg(feature = "hosted")]
 pub use parallel::*;
@@ -112,10 +118,11 @@ const _: () = {
     assert!(size_of::<mpca_status>() == 4 && size_of::<mpca_boundary>() == 4);
 };
 
-/// Checks the leading `struct_size` of a versioned structure.
+/// Checks the leading `struct_size` of a versioned structure; `detail`
+/// names the structure.
 #[inline]
-pub(crate) fn check_size<T>(struct_size: u32) -> Result<(), mpca_status> {
-    if struct_size as usize == core::mem::size_of::<T>() { Ok(()) } else { Err(mpca_status::BadStructSize) }
+pub(crate) fn check_size<T>(struct_size: u32, detail: &'static core::ffi::CStr) -> Result<(), Refusal> {
+    if struct_size as usize == core::mem::size_of::<T>() { Ok(()) } else { Err(Refusal::new(mpca_status::BadStructSize, detail)) }
 }
 
 /// Hosted builds allocate through the C library (with `std` too, so that

@@ -5,7 +5,7 @@
 use mpca_core::Shape;
 
 use crate::desc::mpca_desc;
-use crate::{check_size, guard, mpca_status, mpca_world};
+use crate::{check_size, guard, mpca_status, mpca_world, Refusal};
 
 /// Values of `mpca_shape.kind` (M7).
 #[repr(u32)]
@@ -48,10 +48,12 @@ pub struct mpca_shape {
 
 impl mpca_shape {
     /// The core's shape; a wrong `struct_size` or an unknown kind is
-    /// refused here, the geometry by the core.
-    pub(crate) fn to_core(self) -> Result<Shape, mpca_status> {
-        check_size::<mpca_shape>(self.struct_size)?;
-        Shape::from_parts(self.kind, self.a, self.b, self.radius).ok_or(mpca_status::BadEnum)
+    /// refused here, the geometry by the core. Out of line: six exports
+    /// take a shape.
+    #[inline(never)]
+    pub(crate) fn to_core(self) -> Result<Shape, Refusal> {
+        check_size::<mpca_shape>(self.struct_size, c"shape.struct_size")?;
+        Shape::from_parts(self.kind, self.a, self.b, self.radius).ok_or(Refusal::new(mpca_status::BadEnum, c"shape.kind"))
     }
 }
 
@@ -184,7 +186,7 @@ pub unsafe extern "C" fn mpca_world_surface(
         // 3 floats: an array of them, aligned as a float.
         let normal = c.out(out_normal.cast::<[f32; 3]>())?;
         w.cell(pos)?;
-        let s = w.surface(pos).ok_or(mpca_status::NotASurface)?;
+        let s = w.surface(pos).ok_or(Refusal::new(mpca_status::NotASurface, c"pos"))?;
         normal.set(s.normal);
         e.set(s.restitution);
         Ok(())

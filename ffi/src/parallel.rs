@@ -82,8 +82,8 @@ pub unsafe extern "C" fn mpca_world_step_parallel(
 pub unsafe extern "C" fn mpca_world_step_task(world: *mut mpca_world, ticket: u64, index: u32) -> mpca_status {
     guard(|_| {
         if world.is_null() {
-            return Err(mpca_status::NullPointer);
+            return Err(mpca_status::NullPointer.into());
         }
-        handle::run_task(world, ticket, index)
+        Ok(handle::run_task(world, ticket, index)?)
     })
 }

@@ -4,7 +4,7 @@
 use mpca_core::{Cell, Particle, World};
 
 use crate::snapshot::overlap;
-use crate::{check_size, guard, mpca_status, mpca_world, Call};
+use crate::{check_size, guard, mpca_status, mpca_world, Call, Refusal};
 
 /// One particle.
 #[repr(C)]
@@ -150,7 +150,7 @@ fn export(
     out_count: *mut usize,
     per: usize,
     put: impl Fn(&Particle, &mut [f32]),
-) -> Result<(), mpca_status> {
+) -> Result<(), Refusal> {
     let w = c.world_ref(world)?;
     let Some(n) = counted(c, w, !out.is_null(), capacity, out_count)? else {
         return Ok(()); // the size query
@@ -168,10 +168,10 @@ fn export(
 /// (`has_output`) with room for it; `None` for the size query (nowhere to
 /// write, `capacity` 0); NULL with room claimed refused before the count
 /// is written, a capacity below the count after.
-fn counted(c: &Call<'_>, w: &World, has_output: bool, capacity: usize, out_count: *mut usize) -> Result<Option<usize>, mpca_status> {
+fn counted(c: &Call<'_>, w: &World, has_output: bool, capacity: usize, out_count: *mut usize) -> Result<Option<usize>, Refusal> {
     let count = c.out(out_count)?;
     if !has_output && capacity != 0 {
-        return Err(mpca_status::NullPointer);
+        return Err(Refusal::new(mpca_status::NullPointer, c"out (NULL, capacity not 0)"));
     }
     let n = w.particle_count() as usize;
     count.set(n);
@@ -179,7 +179,7 @@ fn counted(c: &Call<'_>, w: &World, has_output: bool, capacity: usize, out_count
         return Ok(None);
     }
     if capacity < n {
-        return Err(mpca_status::OutputTooSmall);
+        return Err(Refusal::new(mpca_status::OutputTooSmall, c"capacity"));
     }
     Ok(Some(n))
 }
@@ -272,14 +272,14 @@ pub unsafe extern "C" fn mpca_world_export_particles(
     guard(|c| {
         let w = c.world_ref(world)?;
         let cols = c.get(columns)?;
-        check_size::<mpca_particle_columns>(cols.struct_size)?;
+        check_size::<mpca_particle_columns>(cols.struct_size, c"columns.struct_size")?;
         if cols.reserved != 0 {
-            return Err(mpca_status::BadEnum);
+            return Err(Refusal::new(mpca_status::BadEnum, c"columns.reserved"));
         }
         let on = w.description().identity;
         let missing = |column_set: bool, kept: bool| column_set && !kept;
         if missing(!cols.ids.is_null(), on.ids()) || missing(!cols.ages.is_null(), on.ages()) || missing(!cols.tags.is_null(), on.tags()) {
-            return Err(mpca_core::Error::NotEnabled.into());
+            return Err(Refusal::new(mpca_status::NotEnabled, c"columns.ids, ages or tags"));
         }
         let some = !(cols.positions.is_null() && cols.velocities.is_null() && cols.ids.is_null() && cols.ages.is_null() && cols.tags.is_null());
         let Some(n) = counted(c, w, some, capacity, out_count)? else {
@@ -298,7 +298,7 @@ pub unsafe extern "C" fn mpca_world_export_particles(
         ];
         for (i, &(a, a_len)) in spans.iter().enumerate() {
             if spans[i + 1..].iter().any(|&(b, b_len)| overlap(a, a_len, b, b_len)) {
-                return Err(mpca_status::Overlap);
+                return Err(Refusal::new(mpca_status::Overlap, c"columns (two overlap)"));
             }
         }
         let mut positions = c.slice_mut_or_null(cols.positions, triples, too_small)?;

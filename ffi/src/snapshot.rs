@@ -4,9 +4,9 @@
 
 use core::ffi::c_void;
 
-use mpca_core::{Error, World};
+use mpca_core::{ErrorKind, World};
 
-use crate::{fits, guard, handle, mpca_desc, mpca_status, mpca_world};
+use crate::{fits, guard, handle, mpca_desc, mpca_status, mpca_world, Refusal};
 
 /// Whether `a_len` bytes at `a` and `b_len` bytes at `b` share a byte;
 /// found from the addresses alone, before any slice is formed over either.
@@ -56,7 +56,7 @@ pub unsafe extern "C" fn mpca_world_save(world: *const mpca_world, buf: *mut c_v
         }
         let (at, size) = span(w);
         if overlap(buf.cast(), len, at, size) {
-            return Err(mpca_status::Overlap);
+            return Err(Refusal::new(mpca_status::Overlap, c"buf"));
         }
         let out = c.slice_mut(buf.cast::<u8>(), len, mpca_status::BadLength)?;
         match w.save(out) {
@@ -64,9 +64,9 @@ pub unsafe extern "C" fn mpca_world_save(world: *const mpca_world, buf: *mut c_v
                 written.set(n);
                 Ok(())
             }
-            Err(Error::OutputTooSmall) => {
+            Err(e) if e.kind() == ErrorKind::OutputTooSmall => {
                 written.set(need);
-                Err(mpca_status::OutputTooSmall)
+                Err(Refusal::new(mpca_status::OutputTooSmall, c"len"))
             }
             Err(e) => Err(e.into()),
         }
@@ -95,7 +95,7 @@ pub unsafe extern "C" fn mpca_world_load(world: *mut mpca_world, image: *const c
         let w = c.world_to_end(world)?;
         let (at, size) = span(w);
         if overlap(image.cast(), len, at, size) {
-            return Err(mpca_status::Overlap);
+            return Err(Refusal::new(mpca_status::Overlap, c"image"));
         }
         let image = c.slice(image.cast::<u8>(), len, mpca_status::BadLength)?;
         Ok(w.load(image)?)
@@ -135,7 +135,7 @@ pub unsafe extern "C" fn mpca_world_init_from_image(
     guard(|c| {
         let out = c.out(out_world)?;
         if overlap(image.cast(), image_len, memory.cast(), len) {
-            return Err(mpca_status::Overlap);
+            return Err(Refusal::new(mpca_status::Overlap, c"image"));
         }
         let image = c.slice(image.cast::<u8>(), image_len, mpca_status::BadLength)?;
         let bytes = c.slice_mut(memory.cast::<u8>(), len, mpca_status::BadLength)?;

@@ -2,7 +2,7 @@
 
 use core::ffi::{c_char, CStr};
 
-use mpca_core::Error;
+use mpca_core::{Error, ErrorKind};
 
 /// The result of every call. `MPCA_STATUS_OK` is 0; every other value names
 /// one cause. Numbers are never reused: new causes get new numbers.
@@ -157,22 +157,16 @@ impl mpca_status {
         unsafe { core::mem::transmute::<u32, mpca_status>(e.code()) }
     }
 
-    /// The core error this status stands for, if it is one.
-    const fn core_error(self) -> Option<Error> {
+    /// The core error kind this status stands for, if it is one.
+    const fn core_error(self) -> Option<ErrorKind> {
         let mut i = 0;
-        while i < Error::ALL.len() {
-            if Error::ALL[i].code() == self as u32 {
-                return Some(Error::ALL[i]);
+        while i < ErrorKind::ALL.len() {
+            if ErrorKind::ALL[i].code() == self as u32 {
+                return Some(ErrorKind::ALL[i]);
             }
             i += 1;
         }
         None
-    }
-}
-
-impl From<Error> for mpca_status {
-    fn from(e: Error) -> Self {
-        Self::of_error(e)
     }
 }
 
@@ -197,8 +191,8 @@ const fn same_text(a: &CStr, b: &CStr) -> bool {
 // this file says is a core error's (the long arm of `message`) is one.
 const _: () = {
     let mut i = 0;
-    while i < Error::ALL.len() {
-        let e = Error::ALL[i];
+    while i < ErrorKind::ALL.len() {
+        let e = ErrorKind::ALL[i];
         match status_from_u32(e.code()) {
             Some(s) => assert!(same_text(s.message(), e.c_message())),
             None => panic!("a core error has no mpca_status of its number"),
@@ -240,8 +234,9 @@ impl mpca_status {
     }
 }
 
-/// A static, NUL-terminated English message for `status`; never NULL, never
-/// to be freed. Values that are not statuses get a message saying so.
+/// A static, NUL-terminated English message for `status`: what kind of
+/// problem it is (mpca_last_error says where); never NULL, never to be
+/// freed. Values that are not statuses get a message saying so.
 #[unsafe(no_mangle)]
 pub extern "C" fn mpca_status_message(status: u32) -> *const c_char {
     match status_from_u32(status) {
@@ -282,6 +277,6 @@ pub(crate) const fn status_from_u32(n: u32) -> Option<mpca_status> {
 /// The status of a call for a part this build left out, once its arguments
 /// (`_checked`) were read and checked: no world of the build has the part.
 #[cfg(not(feature = "obstacles"))]
-pub(crate) fn disabled<T>(_checked: T) -> mpca_status {
-    mpca_status::NotEnabled
+pub(crate) fn disabled<T>(_checked: T) -> crate::Refusal {
+    crate::Refusal::new(mpca_status::NotEnabled, c"bodies (feature `obstacles`)")
 }

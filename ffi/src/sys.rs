@@ -1,8 +1,10 @@
 //! What a hosted library without Rust's `std` takes from the C library it
 //! is loaded with: memory (`malloc`, `calloc`, `free`, `posix_memalign`),
 //! a lock for the registry of handles (core's atomics, waiting with
-//! `sched_yield`), and, for a panic, one line on stderr (`write`) and
-//! `abort`. These are the only C functions libmpca calls (`readelf -d`
+//! `sched_yield`), a thread-local slot for each thread's last refusal
+//! (`pthread_key_create`, `pthread_getspecific`, `pthread_setspecific`;
+//! `TlsAlloc` and its kin on Windows), and, for a panic, one line on
+//! stderr (`write`) and `abort`. These are the only C functions libmpca calls (`readelf -d`
 //! shows `libc.so.6` as its one dependency).
 //!
 //! Why not `std`: linking it brings its panic machinery (the default hook,
@@ -102,6 +104,138 @@ unsafe impl core::alloc::GlobalAlloc for CAllocator {
         // SAFETY: `p` came from this allocator (GlobalAlloc's contract).
         unsafe { free(p.cast()) }
     }
+}
+
+/// The thread's record of its last refusal (`last_error.rs`): a slot of
+/// the system's thread-local storage holding the detail's address. No
+/// memory is allocated for it, and nothing is to be freed when a thread
+/// ends: the details are static. The slot is made by the first refusal.
+#[cfg(any(unix, windows))]
+mod thread_record {
+    use core::ffi::{c_char, c_void};
+    use core::sync::atomic::{AtomicUsize, Ordering};
+
+    #[cfg(all(unix, any(target_os = "macos", target_os = "ios")))]
+    type Key = core::ffi::c_ulong;
+    #[cfg(all(unix, not(any(target_os = "macos", target_os = "ios"))))]
+    type Key = core::ffi::c_uint;
+
+    #[cfg(unix)]
+    unsafe extern "C" {
+        fn pthread_key_create(key: *mut Key, destructor: Option<unsafe extern "C" fn(*mut c_void)>) -> core::ffi::c_int;
+        fn pthread_key_delete(key: Key) -> core::ffi::c_int;
+        fn pthread_getspecific(key: Key) -> *mut c_void;
+        fn pthread_setspecific(key: Key, value: *const c_void) -> core::ffi::c_int;
+    }
+
+    #[cfg(windows)]
+    type Key = u32;
+
+    #[cfg(windows)]
+    #[link(name = "kernel32")]
+    unsafe extern "system" {
+        fn TlsAlloc() -> u32;
+        fn TlsFree(index: u32) -> i32;
+        fn TlsGetValue(index: u32) -> *mut c_void;
+        fn TlsSetValue(index: u32, value: *mut c_void) -> i32;
+    }
+
+    /// The slot, plus one (0: not made yet).
+    static SLOT: AtomicUsize = AtomicUsize::new(0);
+
+    /// The slot, made on first use; `None` where the system has none left
+    /// (then nothing is recorded).
+    fn slot(make: bool) -> Option<Key> {
+        let k = SLOT.load(Ordering::Acquire);
+        if k != 0 {
+            return Some((k - 1) as Key);
+        }
+        if !make {
+            return None;
+        }
+        #[cfg(unix)]
+        let made = {
+            let mut key: Key = 0;
+            // SAFETY: `key` is a valid out-parameter; no destructor.
+            (unsafe { pthread_key_create(&mut key, None) } == 0).then_some(key)
+        };
+        #[cfg(windows)]
+        // SAFETY: TlsAlloc takes nothing.
+        let made = Some(unsafe { TlsAlloc() }).filter(|&i| i != u32::MAX);
+        let key = made?;
+        match SLOT.compare_exchange(0, key as usize + 1, Ordering::AcqRel, Ordering::Acquire) {
+            Ok(_) => Some(key),
+            // Another thread made one first: that one is the slot.
+            Err(other) => {
+                // SAFETY: `key` was made above and never used.
+                #[cfg(unix)]
+                unsafe {
+                    pthread_key_delete(key);
+                }
+                // SAFETY: as above.
+                #[cfg(windows)]
+                unsafe {
+                    TlsFree(key);
+                }
+                Some((other - 1) as Key)
+            }
+        }
+    }
+
+    /// Sets the calling thread's record.
+    pub(crate) fn set(detail: *const c_char) {
+        if let Some(key) = slot(true) {
+            // SAFETY: `key` is a slot made by `slot`, never deleted.
+            #[cfg(unix)]
+            unsafe {
+                pthread_setspecific(key, detail.cast());
+            }
+            // SAFETY: as above.
+            #[cfg(windows)]
+            unsafe {
+                TlsSetValue(key, detail.cast_mut().cast());
+            }
+        }
+    }
+
+    /// The calling thread's record; NULL before its first refusal.
+    pub(crate) fn get() -> *const c_char {
+        let Some(key) = slot(false) else { return core::ptr::null() };
+        // SAFETY: as in `set`; a slot never set reads NULL.
+        #[cfg(unix)]
+        let p = unsafe { pthread_getspecific(key) };
+        // SAFETY: as above.
+        #[cfg(windows)]
+        let p = unsafe { TlsGetValue(key) };
+        p.cast_const().cast()
+    }
+}
+
+/// Records a refusal's detail for the calling thread.
+#[cfg(any(unix, windows))]
+pub(crate) fn set_thread_detail(detail: *const core::ffi::c_char) {
+    thread_record::set(detail);
+}
+
+/// The calling thread's last refusal's detail, or NULL.
+#[cfg(any(unix, windows))]
+pub(crate) fn thread_detail() -> *const core::ffi::c_char {
+    thread_record::get()
+}
+
+/// Elsewhere no thread-local slot is called for: one record for the
+/// library, as in firmware builds.
+#[cfg(not(any(unix, windows)))]
+static RECORD: core::sync::atomic::AtomicPtr<core::ffi::c_char> = core::sync::atomic::AtomicPtr::new(core::ptr::null_mut());
+
+#[cfg(not(any(unix, windows)))]
+pub(crate) fn set_thread_detail(detail: *const core::ffi::c_char) {
+    RECORD.store(detail.cast_mut(), Ordering::Relaxed);
+}
+
+#[cfg(not(any(unix, windows)))]
+pub(crate) fn thread_detail() -> *const core::ffi::c_char {
+    RECORD.load(Ordering::Relaxed).cast_const()
 }
 
 /// Gives the processor to another thread, where the system has a call for it.

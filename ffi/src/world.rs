@@ -2,7 +2,7 @@
 
 use mpca_core::World;
 
-use crate::{check_size, guard, handle, mpca_desc, mpca_status};
+use crate::{check_size, guard, handle, mpca_desc, mpca_status, Refusal};
 
 /// An opaque world, reached through its handle: the `mpca_world *` that
 /// mpca_world_create or mpca_world_init wrote. A handle is only ever passed
@@ -101,7 +101,7 @@ pub unsafe extern "C" fn mpca_world_deinit(world: *mut mpca_world) -> mpca_statu
     guard(|c| {
         let w = c.world_to_end(world)?;
         if w.is_owned() {
-            return Err(mpca_status::BadHandle);
+            return Err(Refusal::new(mpca_status::BadHandle, c"world (from mpca_world_create: destroy it)"));
         }
         w.retire();
         handle::revoke(world);
@@ -216,7 +216,7 @@ pub unsafe extern "C" fn mpca_world_stats(world: *const mpca_world, out: *mut mp
         let w = c.world_ref(world)?;
         // The caller set the leading struct_size; the rest may be anything.
         let size = *c.get(out.cast_const().cast::<u32>())?;
-        check_size::<mpca_stats>(size)?;
+        check_size::<mpca_stats>(size, c"out->struct_size")?;
         let s = w.stats();
         c.out(out)?.set(mpca_stats {
             struct_size: size,
@@ -289,7 +289,7 @@ pub unsafe extern "C" fn mpca_world_region_stats(
         let w = c.world_ref(world)?;
         let (min, max) = (c.array(min)?, c.array(max)?);
         let size = *c.get(out.cast_const().cast::<u32>())?;
-        check_size::<mpca_region_stats>(size)?;
+        check_size::<mpca_region_stats>(size, c"out->struct_size")?;
         let r = w.region_stats(min, max)?;
         c.out(out)?.set(mpca_region_stats {
             struct_size: size,

@@ -44,14 +44,15 @@ impl Exports {
     pub fn new(world: &GpuWorld, tile: u32) -> Result<Exports, Error> {
         // The exports read the 2D planes' layout.
         if world.host.description().dim != 2 {
-            return Err(Error::World(mpca::Error::FeatureDisabled));
+            return Err(Error::World(mpca::Error::new(mpca::ErrorKind::FeatureDisabled, c"desc.dim: the exports read 2D planes")));
         }
         let device = &world.gpu.device;
         let [nx, ny, _] = world.host.description().size;
         let size = [nx.div_ceil(tile.max(1)), ny.div_ceil(tile.max(1))];
         let largest = device.limits().max_texture_dimension_2d;
         if !tile.is_power_of_two() || size[0] > largest || size[1] > largest {
-            return Err(Error::World(mpca::Error::BadResolution));
+            let why = if tile.is_power_of_two() { c"tile: the texture exceeds the device's largest" } else { c"tile is not a power of two" };
+            return Err(Error::World(mpca::Error::new(mpca::ErrorKind::BadResolution, why)));
         }
         let capacity = world.host.particle_count().max(1);
         let storage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;

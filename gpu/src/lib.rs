@@ -21,8 +21,8 @@
 //! cluster and smoke scenes, the smoke with flow drag and the benchmark's
 //! gas. In 3D the same parts run with exact-fast or greedy assignment: the
 //! paper's water scene among them. 3D exhaustive assignment is refused when
-//! the world is made ([`mpca::Error::FeatureDisabled`]; [`unsupported`]
-//! names it).
+//! the world is made ([`mpca::ErrorKind::FeatureDisabled`], its detail
+//! naming the field; [`unsupported`] names the part).
 //!
 //! ```
 //! use mpca::{Description, WorldBox};
@@ -47,6 +47,9 @@
 mod export;
 
 pub use export::Exports;
+
+use std::ffi::CStr;
+
 use mpca::port::{DragConstants, PortPlanes, StepConstants, StepCounts, VortexConstants};
 use mpca::{Boundary, Collisions, Description, Drift, Method, Quantization, World, WorldBox};
 use wgpu::util::DeviceExt;
@@ -55,7 +58,8 @@ use wgpu::util::DeviceExt;
 #[derive(Debug)]
 pub enum Error {
     /// What the CPU world says: a bad description, or a part this backend
-    /// does not run ([`mpca::Error::FeatureDisabled`]).
+    /// does not run ([`mpca::ErrorKind::FeatureDisabled`]); its detail names
+    /// the field or part at fault.
     World(mpca::Error),
     /// No adapter (a GPU, or a software one such as lavapipe) was found.
     NoAdapter(String),
@@ -69,6 +73,7 @@ pub enum Error {
 impl core::fmt::Display for Error {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         match self {
+            // The kind's message and the detail (mpca::Error's Display).
             Error::World(e) => write!(f, "{e}"),
             Error::NoAdapter(why) => write!(f, "no GPU adapter: {why}"),
             Error::Device(why) => write!(f, "the GPU adapter gave no device: {why}"),
@@ -172,15 +177,29 @@ impl Gpu {
 
 /// Why this backend cannot run a description: `None` where it can.
 pub fn unsupported(d: &Description) -> Option<&'static str> {
-    let checks: [(bool, &'static str); 3] = [
+    refusal(d).map(|(_, part)| part)
+}
+
+/// What [`unsupported`] names, and the detail of the refusal: the field
+/// that asks for it.
+fn refusal(d: &Description) -> Option<(&'static CStr, &'static str)> {
+    let checks: [(bool, &'static CStr, &'static str); 3] = [
         // Correct where loops are not limited, but a dense 3D block's search
         // (8! leaves) runs past the loop limit of Mesa's lavapipe, which
         // ends a shader's loops after 65,535 iterations in all: untested.
-        (d.dim == 2 || d.method != Method::Exhaustive, "exhaustive assignment in 3D"),
-        (!(d.obstacles && d.body_capacity > 0), "bodies, obstacles the caller moves (M13)"),
-        (!d.rest, "resting contact (M5.7b)"),
+        (d.dim == 2 || d.method != Method::Exhaustive, c"desc.method: exhaustive assignment in 3D", "exhaustive assignment in 3D"),
+        (!(d.obstacles && d.body_capacity > 0), c"desc.body_capacity: bodies, obstacles the caller moves (M13)", "bodies, obstacles the caller moves (M13)"),
+        (!d.rest, c"desc.rest: resting contact (M5.7b)", "resting contact (M5.7b)"),
     ];
-    checks.iter().find(|(ok, _)| !ok).map(|(_, what)| *what)
+    checks.iter().find(|(ok, ..)| !ok).map(|&(_, detail, part)| (detail, part))
+}
+
+/// The refusal of a description this backend does not run, if it is one.
+fn check_supported(d: &Description) -> Result<(), Error> {
+    match refusal(d) {
+        Some((detail, _)) => Err(Error::World(mpca::Error::new(mpca::ErrorKind::FeatureDisabled, detail))),
+        None => Ok(()),
+    }
 }
 
 /// Where the tables lie in the shader's table buffer (`step2d.wgsl`).
@@ -280,12 +299,11 @@ pub struct GpuWorld {
 
 impl GpuWorld {
     /// A GPU world holding `world`'s state (a copy: `world` is not
-    /// changed). Refused with [`mpca::Error::FeatureDisabled`] where the
-    /// description needs a part this backend does not run ([`unsupported`]).
+    /// changed). Refused with [`mpca::ErrorKind::FeatureDisabled`] where
+    /// the description needs a part this backend does not run
+    /// ([`unsupported`]).
     pub fn new(gpu: &Gpu, world: &World) -> Result<GpuWorld, Error> {
-        if unsupported(world.description()).is_some() {
-            return Err(Error::World(mpca::Error::FeatureDisabled));
-        }
+        check_supported(world.description())?;
         let mut image = vec![0u8; world.snapshot_bytes()];
         world.save(&mut image)?;
         let mut host = WorldBox::new(world.description())?;
@@ -373,11 +391,9 @@ impl GpuWorld {
     pub fn load(&mut self, image: &[u8]) -> Result<(), Error> {
         let desc = mpca::image_description(image)?;
         if desc.size != self.host.description().size || desc.dim != self.host.description().dim {
-            return Err(Error::World(mpca::Error::ImageMismatch));
+            return Err(Error::World(mpca::Error::new(mpca::ErrorKind::ImageMismatch, c"desc.size")));
         }
-        if unsupported(&desc).is_some() {
-            return Err(Error::World(mpca::Error::FeatureDisabled));
-        }
+        check_supported(&desc)?;
         let mut host = WorldBox::new(&desc)?;
         host.load(image)?;
         // The same plan as the world's (checked by the load): every buffer

@@ -61,7 +61,8 @@ fn filled(desc: &Description, density: f64, place: impl Fn(&mut World)) -> World
                         }
                     }
                     match w.add_particle([x, y, z], v) {
-                        Ok(()) | Err(mpca::Error::CellObstacle) => {}
+                        Ok(()) => {}
+                        Err(e) if e.kind() == mpca::ErrorKind::CellObstacle => {}
                         Err(e) => panic!("{e:?}"),
                     }
                 }
@@ -132,12 +133,16 @@ fn a_part_the_backend_does_not_run_is_refused() {
     let mut d = Description::new_3d(8, 8, 8);
     d.method = mpca::Method::Exhaustive;
     let w = WorldBox::new(&d).unwrap();
-    assert!(matches!(GpuWorld::new(&gpu, &w), Err(mpca_gpu::Error::World(mpca::Error::FeatureDisabled))));
+    let refused = |w: &WorldBox| match GpuWorld::new(&gpu, w) {
+        Err(mpca_gpu::Error::World(e)) => Some((e.kind(), e.detail())),
+        _ => None,
+    };
+    assert_eq!(refused(&w), Some((mpca::ErrorKind::FeatureDisabled, "desc.method: exhaustive assignment in 3D")));
     assert_eq!(mpca_gpu::unsupported(w.description()), Some("exhaustive assignment in 3D"));
     let mut d = Description::new_2d(16, 16);
     (d.obstacles, d.body_capacity, d.body_surface_capacity) = (true, 1, 64);
     let w = WorldBox::new(&d).unwrap();
-    assert!(matches!(GpuWorld::new(&gpu, &w), Err(mpca_gpu::Error::World(mpca::Error::FeatureDisabled))));
+    assert_eq!(refused(&w), Some((mpca::ErrorKind::FeatureDisabled, "desc.body_capacity: bodies, obstacles the caller moves (M13)")));
     assert_eq!(mpca_gpu::unsupported(w.description()), Some("bodies, obstacles the caller moves (M13)"));
 }
 
@@ -225,26 +230,28 @@ fn planes_that_are_not_a_world_are_refused_and_change_nothing() {
     let one = StepCounts { steps: 1, ..StepCounts::default() };
     let first = occupancy.iter().position(|&o| o != 0).unwrap();
     let cell = 64 * first + occupancy[first].trailing_zeros() as usize;
-    // Occupancy, velocities, lifetimes, and the refusal they get.
-    type Case = (Vec<u64>, Vec<u8>, &'static [u8], mpca::Error);
+    // Occupancy, velocities, lifetimes, and the refusal they get: its kind
+    // and the detail naming the plane.
+    use mpca::ErrorKind::{BadLength, ImageInvalid};
+    type Case = (Vec<u64>, Vec<u8>, &'static [u8], (mpca::ErrorKind, &'static str));
     let mut cases: Vec<Case> = Vec::new();
-    cases.push((occupancy[1..].to_vec(), velocity.clone(), &[], mpca::Error::BadLength));
-    cases.push((occupancy.clone(), velocity[1..].to_vec(), &[], mpca::Error::BadLength));
+    cases.push((occupancy[1..].to_vec(), velocity.clone(), &[], (BadLength, "planes.occupancy is not the world's length")));
+    cases.push((occupancy.clone(), velocity[1..].to_vec(), &[], (BadLength, "planes.velocity is not the world's length")));
     // A lifetime plane in a world without lifetimes.
-    cases.push((occupancy.clone(), velocity.clone(), &[0, 0], mpca::Error::BadLength));
+    cases.push((occupancy.clone(), velocity.clone(), &[0, 0], (BadLength, "planes.life is not the world's length")));
     let mut beyond = occupancy.clone();
     beyond[1] |= 1 << 63; // cell 127 of a 66-cell row
     beyond[first] &= beyond[first] - 1;
-    cases.push((beyond, velocity.clone(), &[], mpca::Error::ImageInvalid));
+    cases.push((beyond, velocity.clone(), &[], (ImageInvalid, "planes.occupancy has a bit past a row's end")));
     let mut fast = velocity.clone();
     fast[2 * (cell % 64 + 66 * (first / 2))] = 0x80; // -128: beyond -127
-    cases.push((occupancy.clone(), fast, &[], mpca::Error::ImageInvalid));
+    cases.push((occupancy.clone(), fast, &[], (ImageInvalid, "planes.velocity holds a component out of range")));
     let mut lost = occupancy.clone();
     lost[first] &= lost[first] - 1;
-    cases.push((lost.clone(), velocity.clone(), &[], mpca::Error::ImageInvalid));
+    cases.push((lost.clone(), velocity.clone(), &[], (ImageInvalid, "planes.occupancy does not hold the particles counts says")));
     for (o, v, life, want) in cases {
         let planes = PortPlanes { occupancy: &o, row_words, velocity: &v, life, mass_index: &[], id: &[], age: &[], tag: &[] };
-        assert_eq!(w.port_finish_steps(&planes, &one, &[]), Err(want));
+        assert_eq!(w.port_finish_steps(&planes, &one, &[]).map_err(|e| (e.kind(), e.detail())), Err(want));
         assert_eq!((w.state_hash(), w.stats()), (hash, stats));
     }
     // One particle fewer is what one exit (or one expiry) leaves.
@@ -260,7 +267,8 @@ fn planes_that_are_not_a_world_are_refused_and_change_nothing() {
     let cell = o[0].trailing_zeros() as usize;
     m[cell] = 1;
     let planes = PortPlanes { occupancy: &o, row_words: 1, velocity: &v, life: &[], mass_index: &m, id: &[], age: &[], tag: &[] };
-    assert_eq!(heavy.port_finish_steps(&planes, &one, &[]), Err(mpca::Error::ImageInvalid));
+    let seen = |e: mpca::Error| (e.kind(), e.detail());
+    assert_eq!(heavy.port_finish_steps(&planes, &one, &[]).map_err(seen), Err((ImageInvalid, "planes.mass_index names a class the world has not")));
     // Ids: one never given, and fewer ids given than before.
     let mut named = gas(8, 8, 0.4, 3, |d| d.identity = mpca::Identity::ALL);
     let (o, v, mut id, age, tag) = {
@@ -271,11 +279,11 @@ fn planes_that_are_not_a_world_are_refused_and_change_nothing() {
     let counts = StepCounts { steps: 1, ids_given: given, ..StepCounts::default() };
     let fewer = StepCounts { ids_given: given - 1, ..counts };
     let planes = PortPlanes { occupancy: &o, row_words: 1, velocity: &v, life: &[], mass_index: &[], id: &id, age: &age, tag: &tag };
-    assert_eq!(named.port_finish_steps(&planes, &fewer, &[]), Err(mpca::Error::ImageInvalid));
+    assert_eq!(named.port_finish_steps(&planes, &fewer, &[]).map_err(seen), Err((ImageInvalid, "counts.ids_given is below the world's")));
     let cell = o[0].trailing_zeros() as usize;
     id[4 * cell..4 * cell + 4].copy_from_slice(&(given + 1).to_ne_bytes());
     let planes = PortPlanes { occupancy: &o, row_words: 1, velocity: &v, life: &[], mass_index: &[], id: &id, age: &age, tag: &tag };
-    assert_eq!(named.port_finish_steps(&planes, &counts, &[]), Err(mpca::Error::ImageInvalid));
+    assert_eq!(named.port_finish_steps(&planes, &counts, &[]).map_err(seen), Err((ImageInvalid, "planes.id holds an id never given")));
 }
 
 #[test]
@@ -377,8 +385,9 @@ fn a_world_moves_between_the_cpu_and_the_gpu_through_its_image_mid_run() {
     let before = g.sync().unwrap().state_hash();
     assert_eq!(before, cpu.state_hash());
     let solid = WorldBox::new(&Description::new_3d(48, 40, 2)).unwrap();
-    for (other, why) in [(&*gas(50, 40, 0.4, 31, walls), mpca::Error::ImageMismatch), (&*solid, mpca::Error::ImageMismatch)] {
-        assert!(matches!(g.load(&image(other)), Err(mpca_gpu::Error::World(e)) if e == why));
+    let why = (mpca::ErrorKind::ImageMismatch, "desc.size");
+    for other in [&*gas(50, 40, 0.4, 31, walls), &*solid] {
+        assert!(matches!(g.load(&image(other)), Err(mpca_gpu::Error::World(e)) if (e.kind(), e.detail()) == why));
         assert_eq!(g.sync().unwrap().state_hash(), before);
     }
     g.step(15);

@@ -78,6 +78,8 @@ static const struct symbol {
     SYMBOL(mpca_world_density),
     SYMBOL(mpca_world_density_u8),
     SYMBOL(mpca_status_message),
+    SYMBOL(mpca_last_error),
+    SYMBOL(mpca_world_last_error),
     SYMBOL(mpca_world_init),
     SYMBOL(mpca_world_deinit),
     SYMBOL(mpca_world_create),

@@ -6,8 +6,9 @@
  * - ownership: mpca::world moves and never copies; the world a moved-from,
  *   reassigned, reset or destroyed object held is gone (its handle is
  *   refused by the library);
- * - errors: every refusal throws mpca::error with the status and
- *   mpca_status_message's text, and changes nothing;
+ * - errors: every refusal throws mpca::error with the status, the detail
+ *   mpca_last_error gives (for some, the field it must name) and the two
+ *   as what(), and changes nothing;
  * - the wrapper gives what the C calls give: a scene built both ways
  *   hashes equal, and the exports are the same bytes;
  * - step_parallel with a lambda, a std::function on two std::threads, a
@@ -58,20 +59,33 @@ static void check_true(bool ok, const char *what, int line) {
 }
 #define CHECK(cond) check_true((cond), #cond, __LINE__)
 
-/* `call` must throw mpca::error with status `want` and its message. */
-#define THROWS(want, call)                                                                            \
-    do {                                                                                              \
-        bool thrown_ = false;                                                                         \
-        try {                                                                                         \
-            call;                                                                                     \
-        } catch (const mpca::error &e_) {                                                             \
-            thrown_ = true;                                                                           \
-            check_true(e_.status() == (want), #call ": the status", __LINE__);                        \
-            check_true(std::strcmp(e_.what(), mpca_status_message(want)) == 0, #call ": the message", \
-                       __LINE__);                                                                     \
-        }                                                                                             \
-        check_true(thrown_, #call " throws mpca::error", __LINE__);                                   \
+/* What mpca::error's what() must be: the status's message, then the
+ * detail where it is not that message. */
+static std::string what_of(mpca_status status, const char *detail) {
+    std::string t = mpca_status_message(status);
+    return t == detail ? t : t + ": " + detail;
+}
+
+/* `call` must throw mpca::error with status `want`, the detail this
+ * thread's last refusal has (which `named`, unless NULL, must be), and
+ * the two as what(). */
+#define THROWS_AT(want, named, call)                                                                   \
+    do {                                                                                                \
+        bool thrown_ = false;                                                                           \
+        const char *named_ = (named);                                                                 \
+        try {                                                                                           \
+            call;                                                                                       \
+        } catch (const mpca::error &e_) {                                                               \
+            thrown_ = true;                                                                             \
+            check_true(e_.status() == (want), #call ": the status", __LINE__);                          \
+            check_true(std::strcmp(e_.detail(), mpca_last_error()) == 0, #call ": the detail", __LINE__); \
+            check_true(named_ == nullptr || std::strcmp(e_.detail(), named_) == 0, #call ": names " #named, \
+                       __LINE__);                                                                       \
+            check_true(e_.what() == what_of((want), e_.detail()), #call ": what()", __LINE__);          \
+        }                                                                                               \
+        check_true(thrown_, #call " throws mpca::error", __LINE__);                                     \
     } while (0)
+#define THROWS(want, call) THROWS_AT(want, nullptr, call)
 
 static_assert(!std::is_copy_constructible<mpca::world>::value, "a world is not copied");
 static_assert(!std::is_copy_assignable<mpca::world>::value, "a world is not copied");
@@ -148,34 +162,37 @@ static void ownership() {
 static void errors() {
     mpca_desc odd = mpca::desc_2d(32, 32);
     odd.size[0] = 31;
-    THROWS(MPCA_STATUS_SIZE_ODD, mpca::world w(odd));
+    THROWS_AT(MPCA_STATUS_SIZE_ODD, "desc.size[0]", mpca::world w(odd));
     /* mpca_desc_defaults takes any size; the world refuses it. */
     const mpca_desc zero = mpca::desc_3d(0, 0, 0);
-    THROWS(MPCA_STATUS_SIZE_ZERO, mpca::world w(zero));
+    THROWS_AT(MPCA_STATUS_SIZE_ZERO, "desc.size[0]", mpca::world w(zero));
 
     mpca::world w(box_desc());
     fill_box(w);
     const std::uint64_t before = w.hash();
-    THROWS(MPCA_STATUS_OUT_OF_BOUNDS, w.add_particle({32, 0, 0}, {0.0f, 0.0f, 0.0f}));
+    THROWS_AT(MPCA_STATUS_OUT_OF_BOUNDS, "pos", w.add_particle({32, 0, 0}, {0.0f, 0.0f, 0.0f}));
     THROWS(MPCA_STATUS_CELL_OCCUPIED, w.add_particle({2, 20, 0}, {0.0f, 0.0f, 0.0f}));
-    THROWS(MPCA_STATUS_SPEED_RANGE, w.add_particle({1, 1, 0}, {1.5f, 0.0f, 0.0f}));
-    THROWS(MPCA_STATUS_MASS_RANGE, w.add_particle({1, 1, 0}, {0.0f, 0.0f, 0.0f}, -1.0f));
+    THROWS_AT(MPCA_STATUS_SPEED_RANGE, "velocity", w.add_particle({1, 1, 0}, {1.5f, 0.0f, 0.0f}));
+    THROWS_AT(MPCA_STATUS_MASS_RANGE, "mass", w.add_particle({1, 1, 0}, {0.0f, 0.0f, 0.0f}, -1.0f));
+    CHECK(std::strcmp(w.last_error(), "mass") == 0 && std::strcmp(mpca::last_error(), "mass") == 0);
     THROWS(MPCA_STATUS_NO_PARTICLE, w.remove_particle({1, 1, 0}));
     THROWS(MPCA_STATUS_NOT_FINITE, w.set_gravity({0.0f, std::numeric_limits<float>::quiet_NaN(), 0.0f}));
     THROWS(MPCA_STATUS_BAD_RESOLUTION, w.density({0, 4, 1}));
     THROWS(MPCA_STATUS_BAD_RESOLUTION, w.density_u8({4, 4, 2}));
-    THROWS(MPCA_STATUS_NOT_ENABLED, w.add_disc(16.0f, 16.0f, 4.0f, 1.0f)); /* no obstacles in this world */
+    THROWS_AT(MPCA_STATUS_NOT_ENABLED, "desc.obstacles", w.add_disc(16.0f, 16.0f, 4.0f, 1.0f)); /* no obstacles in this world */
     THROWS(MPCA_STATUS_OUT_OF_BOUNDS, w.set_emitter_rate(0, 1.0f)); /* no emitter 0 */
     THROWS(MPCA_STATUS_BAD_EMITTER, w.set_emitter_rate(0, -1.0f));
-    THROWS(MPCA_STATUS_NOT_ENABLED, w.set_cell_wind({1, 1, 0}, {0.1f, 0.0f, 0.0f})); /* no wind plane */
+    THROWS_AT(MPCA_STATUS_NOT_ENABLED, "desc.drag.field", w.set_cell_wind({1, 1, 0}, {0.1f, 0.0f, 0.0f})); /* no wind plane */
     CHECK(w.hash() == before);
+    /* hash() succeeded: the world's detail is cleared, the thread's kept. */
+    CHECK(*w.last_error() == '\0' && std::strcmp(mpca::last_error(), "desc.drag.field") == 0);
 
     /* Caught as what it derives from, too. */
     bool caught = false;
     try {
         w.add_particle({0, 32, 0}, {0.0f, 0.0f, 0.0f});
     } catch (const std::exception &e) {
-        caught = std::string(e.what()) == mpca_status_message(MPCA_STATUS_OUT_OF_BOUNDS);
+        caught = std::string(e.what()) == what_of(MPCA_STATUS_OUT_OF_BOUNDS, "pos");
     }
     CHECK(caught && w.hash() == before);
     std::printf("cpp: errors\n");
@@ -580,6 +597,8 @@ static void every_function() {
     typedef mpca::world W;
     typedef std::function<void(const mpca::tasks &)> host;
     WRAPS(mpca_version, &mpca::version);
+    WRAPS(mpca_last_error, &mpca::last_error);
+    WRAPS(mpca_world_last_error, &W::last_error);
     WRAPS(mpca_desc_defaults, &mpca::desc_2d);
     WRAPS(mpca_desc_defaults, &mpca::desc_3d);
     WRAPS(mpca_desc_preset, &mpca::preset);

@@ -119,14 +119,52 @@ static uint64_t fingerprint(void) {
     return h;
 }
 
-/* An error case: `call` must return `want` and leave every watched world
- * as it was. */
-#define REFUSED(want, call)                                                                  \
-    do {                                                                                     \
-        uint64_t before_ = fingerprint();                                                    \
-        check_status(TRACE(call), (want), #call, __FILE__, __LINE__);                        \
-        check_true(fingerprint() == before_, "no world changed by " #call, __FILE__, __LINE__); \
-        error_cases++;                                                                       \
+/* The details the last REFUSED call left, read before the fingerprint's
+ * own calls (which change them: a read of a world succeeds, and its
+ * surface query of a cell that is no surface is refused). */
+static const char *thread_detail, *world_detail;
+
+/* An error case: `call` on world `w` (or NULL) must return `want`, leave
+ * every watched world as it was, and leave a detail for this thread
+ * (mpca_last_error) and, where `w` is given, the same for the world
+ * (mpca_world_last_error). */
+#define REFUSED_IN(w, want, call)                                                                 \
+    do {                                                                                          \
+        uint64_t before_ = fingerprint();                                                         \
+        check_status(TRACE(call), (want), #call, __FILE__, __LINE__);                             \
+        thread_detail = TRACE(mpca_last_error());                                                 \
+        world_detail = (w) != NULL ? TRACE(mpca_world_last_error(w)) : thread_detail;             \
+        check_true(fingerprint() == before_, "no world changed by " #call, __FILE__, __LINE__);    \
+        check_true(*thread_detail != '\0', "a detail for " #call, __FILE__, __LINE__);            \
+        check_true(strcmp(world_detail, thread_detail) == 0, "the world's detail of " #call " is the thread's", \
+                   __FILE__, __LINE__);                                                           \
+        error_cases++;                                                                            \
+    } while (0)
+#define REFUSED(want, call) REFUSED_IN(NULL, want, call)
+
+/* Whether `got` is `want`, printing both where not. */
+static int same_detail(const char *got, const char *want, const char *what) {
+    if (strcmp(got, want) == 0) {
+        return 1;
+    }
+    printf("detail of %s: \"%s\", expected \"%s\"\n", what, got, want);
+    return 0;
+}
+
+/* REFUSED, and this thread's detail must be `detail`. */
+#define REFUSED_AT(want, detail, call)                                                                   \
+    do {                                                                                                 \
+        REFUSED(want, call);                                                                             \
+        check_true(same_detail(thread_detail, (detail), #call), "the detail of " #call " is " #detail,   \
+                   __FILE__, __LINE__);                                                                  \
+    } while (0)
+
+/* REFUSED_AT of a call on world `w`, whose detail must be the same. */
+#define REFUSED_ON(w, want, detail, call)                                                                \
+    do {                                                                                                 \
+        REFUSED_IN(w, want, call);                                                                       \
+        check_true(same_detail(thread_detail, (detail), #call), "the detail of " #call " is " #detail,   \
+                   __FILE__, __LINE__);                                                                  \
     } while (0)
 
 /* Which case is running, for failure messages. */
@@ -327,49 +365,58 @@ static void build_worlds(void) {
 #define POOL_BYTES (256 * 1024)
 static unsigned char *pool;
 
-/* A refused description: every function that takes one must return `want`,
- * write no output, and leave the caller's memory as it was. */
-static void desc_refused(const mpca_desc *d, mpca_status want) {
+/* A refused description: every function that takes one must return `want`
+ * with `detail` (the field at fault) as this thread's detail, write no
+ * output, and leave the caller's memory as it was. */
+static void desc_refused(const mpca_desc *d, mpca_status want, const char *detail) {
     size_t bytes = SENTINEL_SIZE;
     mpca_world *const sentinel = (mpca_world *)(void *)&bytes;
     mpca_world *w = sentinel;
-    REFUSED(want, mpca_desc_validate(d));
-    REFUSED(want, mpca_world_bytes(d, &bytes));
+    REFUSED_AT(want, detail, mpca_desc_validate(d));
+    REFUSED_AT(want, detail, mpca_world_bytes(d, &bytes));
     CHECK(bytes == SENTINEL_SIZE);
     memset(pool, SENTINEL_BYTE, POOL_BYTES);
-    REFUSED(want, mpca_world_init(d, pool + 3, POOL_BYTES - 3, &w));
+    REFUSED_AT(want, detail, mpca_world_init(d, pool + 3, POOL_BYTES - 3, &w));
     CHECK(w == sentinel);
     size_t untouched = 0;
     while (untouched < POOL_BYTES && pool[untouched] == SENTINEL_BYTE) {
         untouched++;
     }
     CHECK(untouched == POOL_BYTES);
-    REFUSED(want, mpca_world_create(d, &w));
+    REFUSED_AT(want, detail, mpca_world_create(d, &w));
     CHECK(w == sentinel);
 }
 
-/* Field `field` of a copy of `base` set to each value in turn. */
-#define DESC_VALUES(base, field, want, ...)                                                 \
+/* Field `field` of a copy of `base` set to each value in turn; `detail`
+ * names it. */
+#define DESC_VALUES(base, field, want, detail, ...)                                         \
     do {                                                                                    \
         const uint32_t values_[] = {__VA_ARGS__};                                           \
         for (unsigned i_ = 0; i_ < sizeof values_ / sizeof values_[0]; i_++) {              \
             mpca_desc d_ = (base);                                                          \
             d_.field = values_[i_];                                                         \
             set_context("%uD desc.%s = %u (at = %u)", (base).dim, #field, values_[i_], at); \
-            desc_refused(&d_, (want));                                                      \
+            desc_refused(&d_, (want), (detail));                                            \
         }                                                                                   \
     } while (0)
 
-#define DESC_FLOATS(base, field, want, ...)                                                            \
+#define DESC_FLOATS(base, field, want, detail, ...)                                                    \
     do {                                                                                               \
         const float values_[] = {__VA_ARGS__};                                                         \
         for (unsigned i_ = 0; i_ < sizeof values_ / sizeof values_[0]; i_++) {                         \
             mpca_desc d_ = (base);                                                                     \
             d_.field = values_[i_];                                                                    \
             set_context("%uD desc.%s = %g (at = %u)", (base).dim, #field, (double)values_[i_], at);    \
-            desc_refused(&d_, (want));                                                                 \
+            desc_refused(&d_, (want), (detail));                                                       \
         }                                                                                              \
     } while (0)
+
+/* "desc.NAME[k]": the detail naming entry `k` of an array field. */
+static const char *indexed(const char *name, unsigned k) {
+    static char text[64];
+    snprintf(text, sizeof text, "desc.%s[%u]", name, k);
+    return text;
+}
 
 static void description_cases(void) {
     const mpca_desc bases[2] = {full_desc(2, 16), full_desc(3, 8)};
@@ -378,64 +425,64 @@ static void description_cases(void) {
         const uint32_t dim = base.dim;
         CHECK_OK(mpca_desc_validate(&base));
 
-        DESC_VALUES(base, struct_size, MPCA_STATUS_BAD_STRUCT_SIZE, 0, sizeof(mpca_desc) - 4,
+        DESC_VALUES(base, struct_size, MPCA_STATUS_BAD_STRUCT_SIZE, "desc.struct_size", 0, sizeof(mpca_desc) - 4,
                     sizeof(mpca_desc) + 4, UINT32_MAX);
-        DESC_VALUES(base, dim, MPCA_STATUS_BAD_DIMENSION, 0, 1, 4, UINT32_MAX);
+        DESC_VALUES(base, dim, MPCA_STATUS_BAD_DIMENSION, "desc.dim", 0, 1, 4, UINT32_MAX);
         for (at = 0; at < dim; at++) {
-            DESC_VALUES(base, size[at], MPCA_STATUS_SIZE_ZERO, 0);
-            DESC_VALUES(base, size[at], MPCA_STATUS_SIZE_ODD, 1, 7, 15);
+            DESC_VALUES(base, size[at], MPCA_STATUS_SIZE_ZERO, indexed("size", at), 0);
+            DESC_VALUES(base, size[at], MPCA_STATUS_SIZE_ODD, indexed("size", at), 1, 7, 15);
         }
         /* Every face, also the unused third axis of 2D: its value is still
          * an enumeration the library must know. */
         for (at = 0; at < 6; at++) {
-            DESC_VALUES(base, boundary[at / 2][at % 2], MPCA_STATUS_BAD_ENUM, 3, UINT32_MAX);
+            DESC_VALUES(base, boundary[at / 2][at % 2], MPCA_STATUS_BAD_ENUM, "desc.boundary", 3, UINT32_MAX);
         }
         for (at = 0; at < dim; at++) {
-            DESC_VALUES(base, boundary[at][0], MPCA_STATUS_PERIODIC_MISMATCH, MPCA_BOUNDARY_PERIODIC);
-            DESC_VALUES(base, boundary[at][1], MPCA_STATUS_PERIODIC_MISMATCH, MPCA_BOUNDARY_PERIODIC);
+            DESC_VALUES(base, boundary[at][0], MPCA_STATUS_PERIODIC_MISMATCH, indexed("boundary", at), MPCA_BOUNDARY_PERIODIC);
+            DESC_VALUES(base, boundary[at][1], MPCA_STATUS_PERIODIC_MISMATCH, indexed("boundary", at), MPCA_BOUNDARY_PERIODIC);
         }
         at = 0;
-        DESC_VALUES(base, per_particle_mass, MPCA_STATUS_BAD_ENUM, 2, UINT32_MAX);
-        DESC_VALUES(base, obstacles, MPCA_STATUS_BAD_ENUM, 2, UINT32_MAX);
-        DESC_VALUES(base, lifetimes, MPCA_STATUS_BAD_ENUM, 2, UINT32_MAX);
-        DESC_VALUES(base, forces, MPCA_STATUS_BAD_ENUM, 16, 0x80000000u, UINT32_MAX);
-        DESC_VALUES(base, quantization, MPCA_STATUS_BAD_ENUM, 0, 1, 4, 32);
-        DESC_VALUES(base, drift, MPCA_STATUS_BAD_ENUM, 2, UINT32_MAX);
-        DESC_VALUES(base, method, MPCA_STATUS_BAD_ENUM, 3, UINT32_MAX);
-        DESC_VALUES(base, collisions, MPCA_STATUS_BAD_ENUM, 2, UINT32_MAX);
-        DESC_VALUES(base, contacts, MPCA_STATUS_BAD_ENUM, 2, UINT32_MAX);
-        DESC_VALUES(base, rest, MPCA_STATUS_BAD_ENUM, 2, UINT32_MAX);
-        DESC_VALUES(base, reserved, MPCA_STATUS_BAD_ENUM, 1, UINT32_MAX);
-        DESC_VALUES(base, energy_neutral, MPCA_STATUS_BAD_ENUM, 2, UINT32_MAX);
-        DESC_VALUES(base, drag_vortex, MPCA_STATUS_BAD_ENUM, 2, UINT32_MAX);
-        DESC_VALUES(base, drag_wind_field, MPCA_STATUS_BAD_ENUM, 2, UINT32_MAX);
-        DESC_VALUES(base, identity, MPCA_STATUS_BAD_ENUM, 8, UINT32_MAX);
-        DESC_VALUES(base, mass_classes, MPCA_STATUS_CAPACITY_RANGE, 0, 257, UINT32_MAX);
+        DESC_VALUES(base, per_particle_mass, MPCA_STATUS_BAD_ENUM, "desc.per_particle_mass", 2, UINT32_MAX);
+        DESC_VALUES(base, obstacles, MPCA_STATUS_BAD_ENUM, "desc.obstacles", 2, UINT32_MAX);
+        DESC_VALUES(base, lifetimes, MPCA_STATUS_BAD_ENUM, "desc.lifetimes", 2, UINT32_MAX);
+        DESC_VALUES(base, forces, MPCA_STATUS_BAD_ENUM, "desc.forces", 16, 0x80000000u, UINT32_MAX);
+        DESC_VALUES(base, quantization, MPCA_STATUS_BAD_ENUM, "desc.quantization", 0, 1, 4, 32);
+        DESC_VALUES(base, drift, MPCA_STATUS_BAD_ENUM, "desc.drift", 2, UINT32_MAX);
+        DESC_VALUES(base, method, MPCA_STATUS_BAD_ENUM, "desc.method", 3, UINT32_MAX);
+        DESC_VALUES(base, collisions, MPCA_STATUS_BAD_ENUM, "desc.collisions", 2, UINT32_MAX);
+        DESC_VALUES(base, contacts, MPCA_STATUS_BAD_ENUM, "desc.contacts", 2, UINT32_MAX);
+        DESC_VALUES(base, rest, MPCA_STATUS_BAD_ENUM, "desc.rest", 2, UINT32_MAX);
+        DESC_VALUES(base, reserved, MPCA_STATUS_BAD_ENUM, "desc.reserved", 1, UINT32_MAX);
+        DESC_VALUES(base, energy_neutral, MPCA_STATUS_BAD_ENUM, "desc.energy_neutral", 2, UINT32_MAX);
+        DESC_VALUES(base, drag_vortex, MPCA_STATUS_BAD_ENUM, "desc.drag_vortex", 2, UINT32_MAX);
+        DESC_VALUES(base, drag_wind_field, MPCA_STATUS_BAD_ENUM, "desc.drag_wind_field", 2, UINT32_MAX);
+        DESC_VALUES(base, identity, MPCA_STATUS_BAD_ENUM, "desc.identity", 8, UINT32_MAX);
+        DESC_VALUES(base, mass_classes, MPCA_STATUS_CAPACITY_RANGE, "desc.mass_classes", 0, 257, UINT32_MAX);
 
         /* Every float field, the third gravity component in 2D included. */
-        DESC_FLOATS(base, mass, MPCA_STATUS_NOT_FINITE, NAN, INFINITY, -INFINITY);
+        DESC_FLOATS(base, mass, MPCA_STATUS_NOT_FINITE, "desc.mass", NAN, INFINITY, -INFINITY);
         for (at = 0; at < 3; at++) {
-            DESC_FLOATS(base, gravity[at], MPCA_STATUS_NOT_FINITE, NAN, INFINITY, -INFINITY);
+            DESC_FLOATS(base, gravity[at], MPCA_STATUS_NOT_FINITE, "desc.gravity", NAN, INFINITY, -INFINITY);
         }
         for (at = 0; at < 2; at++) {
-            DESC_FLOATS(base, vortex_centre[at], MPCA_STATUS_NOT_FINITE, NAN, INFINITY, -INFINITY);
+            DESC_FLOATS(base, vortex_centre[at], MPCA_STATUS_NOT_FINITE, "desc.vortex", NAN, INFINITY, -INFINITY);
         }
         at = 0;
-        DESC_FLOATS(base, vortex_core_radius, MPCA_STATUS_NOT_FINITE, NAN, INFINITY, -INFINITY);
-        DESC_FLOATS(base, vortex_circulation, MPCA_STATUS_NOT_FINITE, NAN, INFINITY, -INFINITY);
-        DESC_FLOATS(base, restitution, MPCA_STATUS_NOT_FINITE, NAN, INFINITY, -INFINITY);
-        DESC_FLOATS(base, wall_restitution, MPCA_STATUS_NOT_FINITE, NAN, INFINITY, -INFINITY);
-        DESC_FLOATS(base, dt, MPCA_STATUS_NOT_FINITE, NAN, INFINITY, -INFINITY);
+        DESC_FLOATS(base, vortex_core_radius, MPCA_STATUS_NOT_FINITE, "desc.vortex", NAN, INFINITY, -INFINITY);
+        DESC_FLOATS(base, vortex_circulation, MPCA_STATUS_NOT_FINITE, "desc.vortex", NAN, INFINITY, -INFINITY);
+        DESC_FLOATS(base, restitution, MPCA_STATUS_NOT_FINITE, "desc.restitution", NAN, INFINITY, -INFINITY);
+        DESC_FLOATS(base, wall_restitution, MPCA_STATUS_NOT_FINITE, "desc.wall_restitution", NAN, INFINITY, -INFINITY);
+        DESC_FLOATS(base, dt, MPCA_STATUS_NOT_FINITE, "desc.dt", NAN, INFINITY, -INFINITY);
 
-        DESC_FLOATS(base, mass, MPCA_STATUS_MASS_RANGE, 0.0f, -0.0f, -1.0f);
-        DESC_FLOATS(base, restitution, MPCA_STATUS_RESTITUTION_RANGE, 1.5f, -0.1f, 1.0000001f);
-        DESC_FLOATS(base, wall_restitution, MPCA_STATUS_RESTITUTION_RANGE, 1.5f, -0.1f);
-        DESC_FLOATS(base, dt, MPCA_STATUS_NEGATIVE_DT, -1.0f, -1e-30f);
-        DESC_FLOATS(base, vortex_core_radius, MPCA_STATUS_BAD_VORTEX, 0.0f, -2.0f);
-        DESC_FLOATS(base, drag_rate, MPCA_STATUS_NOT_FINITE, NAN, INFINITY, -INFINITY);
-        DESC_FLOATS(base, drag_rate, MPCA_STATUS_BAD_DRAG, -1.0f, -1e-30f);
-        DESC_FLOATS(base, drag_wind[0], MPCA_STATUS_NOT_FINITE, NAN, INFINITY);
-        DESC_FLOATS(base, drag_wind[1], MPCA_STATUS_SPEED_RANGE, 1.0001f, -2.0f);
+        DESC_FLOATS(base, mass, MPCA_STATUS_MASS_RANGE, "desc.mass", 0.0f, -0.0f, -1.0f);
+        DESC_FLOATS(base, restitution, MPCA_STATUS_RESTITUTION_RANGE, "desc.restitution", 1.5f, -0.1f, 1.0000001f);
+        DESC_FLOATS(base, wall_restitution, MPCA_STATUS_RESTITUTION_RANGE, "desc.wall_restitution", 1.5f, -0.1f);
+        DESC_FLOATS(base, dt, MPCA_STATUS_NEGATIVE_DT, "desc.dt", -1.0f, -1e-30f);
+        DESC_FLOATS(base, vortex_core_radius, MPCA_STATUS_BAD_VORTEX, "desc.vortex.core_radius", 0.0f, -2.0f);
+        DESC_FLOATS(base, drag_rate, MPCA_STATUS_NOT_FINITE, "desc.drag.rate", NAN, INFINITY, -INFINITY);
+        DESC_FLOATS(base, drag_rate, MPCA_STATUS_BAD_DRAG, "desc.drag.rate", -1.0f, -1e-30f);
+        DESC_FLOATS(base, drag_wind[0], MPCA_STATUS_NOT_FINITE, "desc.drag.wind", NAN, INFINITY);
+        DESC_FLOATS(base, drag_wind[1], MPCA_STATUS_SPEED_RANGE, "desc.drag.wind", 1.0001f, -2.0f);
     }
 
     /* 2^16 x 2^16 x 2 cells: more than a 32-bit cell index holds. */
@@ -443,7 +490,7 @@ static void description_cases(void) {
     d.size[0] = d.size[1] = 65536;
     d.size[2] = 2;
     set_context("3D desc of 2^33 cells");
-    desc_refused(&d, MPCA_STATUS_TOO_LARGE);
+    desc_refused(&d, MPCA_STATUS_TOO_LARGE, "desc.size");
 
     set_context("NULL descriptions and outputs");
     d = bases[0];
@@ -1673,6 +1720,161 @@ static void message_cases(void) {
     printf("version: %s\n", version != NULL ? version : "(null)");
 }
 
+/* --- Details (issue 27 item 3) ----------------------------------------- */
+
+/* A free cell of `w` (2D), into `pos`. */
+static void free_cell(const mpca_world *w, uint32_t pos[3]) {
+    mpca_desc d;
+    CHECK_OK(mpca_world_desc(w, &d));
+    for (pos[2] = 0, pos[1] = 0; pos[1] < d.size[1]; pos[1]++) {
+        for (pos[0] = 0; pos[0] < d.size[0]; pos[0]++) {
+            mpca_cell c;
+            CHECK_OK(mpca_world_cell(w, pos, &c));
+            if (c.kind == MPCA_CELL_KIND_EMPTY) {
+                return;
+            }
+        }
+    }
+    CHECK(!"a free cell");
+}
+
+/* Each refusal's detail names the field, argument or part at fault, the
+ * same for the thread (mpca_last_error) and the world called
+ * (mpca_world_last_error); refusals of one kind for different fields name
+ * different ones; a call on the world that succeeds clears its detail and
+ * leaves the thread's, and a refusal on another world leaves it too. */
+static void detail_cases(void) {
+    set_context("details");
+    uint32_t pos[3] = {1, 1, 0}, outside[3] = {N2, 0, 0}, bare_free[3], full_free[3];
+    float nan3[3] = {NAN, 0, 0}, zero[3] = {0, 0, 0}, up[3] = {0, 1, 0};
+    uint64_t requested = SENTINEL_SIZE, delivered = SENTINEL_SIZE;
+    uint32_t index = SENTINEL_U32;
+    free_cell(bare2, bare_free);
+    free_cell(full2, full_free);
+
+    /* Not enabled: each call names the part its world was made without. */
+    mpca_emitter e = emitter_at(2, 2, 0, 2);
+    e.lifetime = 0;
+    REFUSED_ON(bare2, MPCA_STATUS_NOT_ENABLED, "desc.obstacles", mpca_world_add_obstacle(bare2, pos, up, 1.0f));
+    REFUSED_ON(bare2, MPCA_STATUS_NOT_ENABLED, "desc.forces.uniform", mpca_world_set_gravity(bare2, up));
+    REFUSED_ON(bare2, MPCA_STATUS_NOT_ENABLED, "desc.forces.field", mpca_world_set_cell_force(bare2, pos, zero));
+    REFUSED_ON(bare2, MPCA_STATUS_NOT_ENABLED, "desc.forces.potential", mpca_world_set_cell_potential(bare2, pos, 0.0f));
+    REFUSED_ON(bare2, MPCA_STATUS_NOT_ENABLED, "desc.forces.vortex", mpca_world_set_vortex(bare2, 1.0f, 1.0f, 1.0f, 1.0f));
+    REFUSED_ON(bare2, MPCA_STATUS_NOT_ENABLED, "desc.drag.field", mpca_world_set_cell_wind(bare2, pos, zero));
+    REFUSED_ON(bare2, MPCA_STATUS_NOT_ENABLED, "desc.emitter_capacity is 0", mpca_world_add_emitter(bare2, &e, &index));
+    REFUSED_ON(bare2, MPCA_STATUS_NOT_ENABLED, "desc.identity (no tags)", mpca_world_set_tag(bare2, pos, 1));
+    REFUSED_ON(bare2, MPCA_STATUS_NOT_ENABLED, "mass is not desc.mass (desc.per_particle_mass is off)",
+               mpca_world_add_particle_mass(bare2, bare_free, zero, 2.0f));
+    mpca_shape disc;
+    memset(&disc, 0, sizeof disc);
+    disc.struct_size = sizeof disc;
+    disc.kind = MPCA_SHAPE_KIND_DISC;
+    disc.a[0] = disc.a[1] = 4.0f;
+    disc.radius = 1.0f;
+    uint32_t id = SENTINEL_U32;
+    REFUSED_ON(full2, MPCA_STATUS_NOT_ENABLED, "desc.obstacles or desc.body_capacity",
+               mpca_world_add_body(full2, &disc, zero, 1.0f, &id));
+    e.lifetime = 30;
+    REFUSED_ON(bare2, MPCA_STATUS_NOT_ENABLED, "emitter.lifetime (desc.lifetimes is off)", mpca_world_add_emitter(bare2, &e, &index));
+    CHECK(index == SENTINEL_U32 && id == SENTINEL_U32);
+
+    /* Not finite: each names its argument or field. */
+    REFUSED_ON(full2, MPCA_STATUS_NOT_FINITE, "gravity", mpca_world_set_gravity(full2, nan3));
+    REFUSED_ON(full2, MPCA_STATUS_NOT_FINITE, "vortex", mpca_world_set_vortex(full2, NAN, 8.0f, 3.0f, 0.2f));
+    REFUSED_ON(full2, MPCA_STATUS_NOT_FINITE, "force", mpca_world_set_cell_force(full2, pos, nan3));
+    REFUSED_ON(full2, MPCA_STATUS_NOT_FINITE, "potential", mpca_world_set_cell_potential(full2, pos, NAN));
+    REFUSED_ON(full2, MPCA_STATUS_NOT_FINITE, "wind", mpca_world_set_cell_wind(full2, pos, nan3));
+    REFUSED_ON(full2, MPCA_STATUS_NOT_FINITE, "velocity", mpca_world_add_particle(full2, full_free, nan3));
+    REFUSED_ON(full2, MPCA_STATUS_NOT_FINITE, "rate", mpca_world_set_emitter_rate(full2, 0, NAN));
+    REFUSED_ON(full2, MPCA_STATUS_NOT_FINITE, "normal", mpca_world_add_obstacle(full2, full_free, nan3, 1.0f));
+    REFUSED_ON(full2, MPCA_STATUS_NOT_FINITE, "e", mpca_world_add_obstacle(full2, full_free, up, NAN));
+    REFUSED_ON(full2, MPCA_STATUS_NOT_FINITE, "shape", mpca_world_add_disc(full2, NAN, 5.0f, 1.0f, 1.0f));
+    e.mass = NAN;
+    REFUSED_ON(emit2, MPCA_STATUS_NOT_FINITE, "emitter.mass", mpca_world_add_emitter(emit2, &e, &index));
+    e.mass = 1;
+
+    /* Out of bounds, bad shapes, bad emitters: one kind, several fields. */
+    mpca_region_stats region;
+    memset(&region, 0, sizeof region);
+    region.struct_size = sizeof region;
+    uint32_t lo[3] = {4, 4, 0}, hi[3] = {2, 8, 1}, far[3] = {N2 + 1, 8, 1};
+    REFUSED_ON(full2, MPCA_STATUS_OUT_OF_BOUNDS, "pos", mpca_world_add_particle(full2, outside, zero));
+    REFUSED_ON(full2, MPCA_STATUS_OUT_OF_BOUNDS, "index (past the emitters)",
+               mpca_world_emitter_stats(full2, 2, &requested, &delivered)); /* both slots used */
+    REFUSED_ON(full2, MPCA_STATUS_OUT_OF_BOUNDS, "max", mpca_world_region_stats(full2, lo, far, &region));
+    REFUSED_ON(full2, MPCA_STATUS_BAD_SHAPE, "min is not below max", mpca_world_region_stats(full2, lo, hi, &region));
+    REFUSED_ON(full2, MPCA_STATUS_BAD_SHAPE, "shape: radius", mpca_world_add_disc(full2, 5.0f, 5.0f, 0.0f, 1.0f));
+    float box_lo[3] = {5, 5, 0}, box_hi[3] = {4, 6, 1};
+    REFUSED_ON(full2, MPCA_STATUS_BAD_SHAPE, "shape: box min above max", mpca_world_add_box(full2, box_lo, box_hi, 1.0f));
+    e.rate = -1.0f;
+    REFUSED_ON(emit2, MPCA_STATUS_BAD_EMITTER, "emitter.rate is negative", mpca_world_add_emitter(emit2, &e, &index));
+    e.rate = 0.5f;
+    e.max[0] = N2 + 1;
+    REFUSED_ON(emit2, MPCA_STATUS_BAD_EMITTER, "emitter.max is past the world", mpca_world_add_emitter(emit2, &e, &index));
+    e.max[0] = e.min[0];
+    REFUSED_ON(emit2, MPCA_STATUS_BAD_EMITTER, "emitter.min is not below max", mpca_world_add_emitter(emit2, &e, &index));
+    REFUSED_ON(full2, MPCA_STATUS_BAD_EMITTER, "rate", mpca_world_set_emitter_rate(full2, 0, -1.0f));
+    CHECK(requested == SENTINEL_SIZE && delivered == SENTINEL_SIZE && index == SENTINEL_U32);
+
+    /* The C boundary's own: the structure or field named. */
+    e = emitter_at(2, 2, 0, 2);
+    e.struct_size = 8;
+    REFUSED_ON(emit2, MPCA_STATUS_BAD_STRUCT_SIZE, "emitter.struct_size", mpca_world_add_emitter(emit2, &e, &index));
+    disc.kind = 9;
+    REFUSED_ON(full2, MPCA_STATUS_BAD_ENUM, "shape.kind", mpca_world_add_shape(full2, &disc, 1.0f));
+
+    /* Snapshots: which part of the image is wrong. */
+    size_t need = 0, need3 = 0;
+    CHECK_OK(mpca_world_save(full2, NULL, 0, &need));
+    CHECK_OK(mpca_world_save(full3, NULL, 0, &need3));
+    unsigned char *image = malloc(need), *image3 = malloc(need3);
+    CHECK(image != NULL && image3 != NULL);
+    if (image != NULL && image3 != NULL) {
+        CHECK_OK(mpca_world_save(full2, image, need, &need));
+        CHECK_OK(mpca_world_save(full3, image3, need3, &need3));
+        REFUSED_ON(full2, MPCA_STATUS_IMAGE_LENGTH, "header", mpca_world_load(full2, image, 12));
+        REFUSED_ON(full2, MPCA_STATUS_IMAGE_LENGTH, "header: length", mpca_world_load(full2, image, need - 1));
+        image[need / 2] ^= 0x10;
+        REFUSED_ON(full2, MPCA_STATUS_IMAGE_CHECKSUM, "checksum", mpca_world_load(full2, image, need));
+        image[need / 2] ^= 0x10;
+        image[8] ^= 0x40; /* the version */
+        REFUSED_ON(full2, MPCA_STATUS_IMAGE_VERSION, "header: version", mpca_world_load(full2, image, need));
+        image[8] ^= 0x40;
+        image[0] ^= 1;
+        REFUSED_ON(full2, MPCA_STATUS_NOT_AN_IMAGE, "header: magic", mpca_world_load(full2, image, need));
+        image[0] ^= 1;
+        REFUSED_ON(full2, MPCA_STATUS_IMAGE_MISMATCH, "desc.size", mpca_world_load(full2, image3, need3));
+        /* Of the size, with another capacity: that capacity named. */
+        mpca_desc d = full_desc(2, N2);
+        d.emitter_capacity = 3;
+        mpca_world *other = NULL;
+        CHECK_OK(mpca_world_create(&d, &other));
+        REFUSED_ON(other, MPCA_STATUS_IMAGE_MISMATCH, "desc.emitter_capacity", mpca_world_load(other, image, need));
+        CHECK_OK(mpca_world_destroy(other));
+    }
+    free(image);
+    free(image3);
+
+    /* A step task of no step: the thread's detail is the status's message
+     * (a status that says it all); no world records it. */
+    REFUSED_AT(MPCA_STATUS_STALE_TASK, mpca_status_message(MPCA_STATUS_STALE_TASK), mpca_world_step_task(full2, 12345, 0));
+
+    /* A success clears the world's detail, not the thread's; a refusal on
+     * another world leaves it (calls of their own: REFUSED reads every
+     * watched world, which clears them). */
+    CHECK(TRACE(mpca_world_set_gravity(full2, nan3)) == MPCA_STATUS_NOT_FINITE);
+    CHECK(TRACE(mpca_world_set_gravity(bare2, up)) == MPCA_STATUS_NOT_ENABLED);
+    CHECK(strcmp(mpca_world_last_error(full2), "gravity") == 0);
+    CHECK(strcmp(mpca_world_last_error(bare2), "desc.forces.uniform") == 0);
+    CHECK(strcmp(mpca_last_error(), "desc.forces.uniform") == 0);
+    uint64_t hash = 0;
+    CHECK_OK(mpca_world_hash(full2, &hash));
+    CHECK(*mpca_world_last_error(full2) == '\0');
+    CHECK(strcmp(mpca_world_last_error(bare2), "desc.forces.uniform") == 0);
+    CHECK(strcmp(mpca_last_error(), "desc.forces.uniform") == 0);
+    CHECK(strcmp(mpca_world_last_error(NULL), "world (not a live handle)") == 0);
+}
+
 /* The success paths that the error cases above do not reach. */
 static void success_cases(void) {
     set_context("success paths");
@@ -1719,6 +1921,7 @@ int main(void) {
     body_cases();
     handle_cases();
     message_cases();
+    detail_cases();
     success_cases();
 
     set_context("teardown");

@@ -22,6 +22,10 @@
  *   its memory, or deinitialises or destroys it, until that is accepted.
  *   The user's calls are OK, BUSY or, once it ended, BAD_HANDLE; the new
  *   world was never stepped.
+ * - Details per thread: two threads refuse descriptions for different
+ *   fields at the same time, and each reads its own detail
+ *   (mpca_last_error) back after every refusal; a thread that has refused
+ *   nothing reads "".
  *
  * Worker threads record what they saw and the main thread checks it after
  * joining them (check.c's counters are not shared between threads).
@@ -526,10 +530,60 @@ static void ending_a_world_in_use(void) {
     free(memory);
 }
 
+/* --- Details per thread ------------------------------------------------ */
+
+#define DETAIL_ROUNDS 20000
+
+/* A thread's refusals: a description refused for `field`, whose detail
+ * mpca_last_error must give back each time. */
+struct refuser {
+    mpca_desc desc;
+    const char *field;
+    const char *before; /* the detail before its first refusal */
+    unsigned wrong;     /* refusals whose status or detail was another */
+};
+
+/* Runs on two threads at once: no check.c calls (its counters are not
+ * shared), what it saw goes into `r`. */
+static void *refuse_loop(void *arg) {
+    struct refuser *r = arg;
+    r->before = mpca_last_error();
+    for (unsigned i = 0; i < DETAIL_ROUNDS; i++) {
+        mpca_status s = mpca_desc_validate(&r->desc);
+        const char *d = mpca_last_error();
+        r->wrong += s == MPCA_STATUS_OK || strcmp(d, r->field) != 0;
+    }
+    return NULL;
+}
+
+static void details_per_thread(void) {
+    check_context = "details per thread";
+    struct refuser odd, flat;
+    memset(&odd, 0, sizeof odd);
+    memset(&flat, 0, sizeof flat);
+    gas_desc(&odd.desc);
+    odd.desc.size[1] = 7;
+    odd.field = "desc.size[1]";
+    gas_desc(&flat.desc);
+    flat.desc.dim = 4;
+    flat.field = "desc.dim";
+    pthread_t other;
+    CHECK(pthread_create(&other, NULL, refuse_loop, &flat) == 0);
+    refuse_loop(&odd);
+    CHECK(pthread_join(other, NULL) == 0);
+    /* The main thread refused before (memory in use); the other had not. */
+    CHECK(strcmp(flat.before, "") == 0);
+    CHECK(odd.wrong == 0 && flat.wrong == 0);
+    /* The other thread's refusals left this thread's as it was. */
+    CHECK(strcmp(mpca_last_error(), "desc.size[1]") == 0);
+    printf("threads: details per thread: %u refusals each, %u read back wrong\n", DETAIL_ROUNDS, odd.wrong + flat.wrong);
+}
+
 int main(void) {
     check_begin();
     readers_and_steps();
     memory_in_use();
     ending_a_world_in_use();
+    details_per_thread();
     return check_end();
 }

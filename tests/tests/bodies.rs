@@ -8,7 +8,7 @@
 mod common;
 
 use common::{memory, Z};
-use mpca::{Boundary, Cell, Description, Error, Identity, Quantization, Shape, World};
+use mpca::{Boundary, Cell, Description, Error, ErrorKind, Identity, Quantization, Shape, World};
 use mpca_tests::setup::SetupRng;
 
 /// A description with room for bodies.
@@ -267,36 +267,41 @@ fn a_refused_body_call_changes_nothing() {
     w.step(3);
     let before = image(w);
     type Call = Box<dyn Fn(&mut World) -> Result<(), Error>>;
-    let cases: Vec<(&str, Error, Call)> = vec![
-        ("radius 0", Error::BadShape, Box::new(move |w| w.add_body(disc(8.0, 0.0), [0.0; 3], 1.0).map(drop))),
-        ("NaN centre", Error::NotFinite, Box::new(move |w| w.add_body(disc(f32::NAN, 2.0), [0.0; 3], 1.0).map(drop))),
-        ("too fast", Error::SpeedRange, Box::new(move |w| w.add_body(disc(8.0, 2.0), [0.8, 0.8, 0.0], 1.0).map(drop))),
-        ("e = 2", Error::RestitutionRange, Box::new(move |w| w.add_body(disc(8.0, 2.0), [0.0; 3], 2.0).map(drop))),
-        ("a sphere in 2D", Error::BadDimension, Box::new(|w| w.add_body(Shape::Sphere { centre: [8.0; 3], radius: 2.0 }, [0.0; 3], 1.0).map(drop))),
-        ("no room", Error::SurfaceTableFull, Box::new(move |w| w.add_body(low(6.0), [0.0; 3], 1.0).map(drop))),
-        ("move: no room", Error::SurfaceTableFull, Box::new(move |w| w.move_body(0, disc(16.0, 12.0), [0.0; 3]))),
-        ("move: unknown id", Error::NoBody, Box::new(move |w| w.move_body(1, disc(8.0, 2.0), [0.0; 3]))),
-        ("move: too fast", Error::SpeedRange, Box::new(move |w| w.move_body(0, disc(8.0, 2.0), [1.5, 0.0, 0.0]))),
-        ("remove: unknown id", Error::NoBody, Box::new(|w| w.remove_body(7))),
-        ("stats: unknown id", Error::NoBody, Box::new(|w| w.body_stats(1).map(drop))),
-        ("a static obstacle over a body", Error::CellObstacle, Box::new(|w| w.add_shape(Shape::Box { min: [15.0, 15.0, 0.0], max: [17.0, 17.0, 0.0] }, 1.0))),
+    // Each with the kind, and the detail naming the argument or field.
+    let cases: Vec<(&str, ErrorKind, &str, Call)> = vec![
+        ("radius 0", ErrorKind::BadShape, "shape: radius", Box::new(move |w| w.add_body(disc(8.0, 0.0), [0.0; 3], 1.0).map(drop))),
+        ("NaN centre", ErrorKind::NotFinite, "shape", Box::new(move |w| w.add_body(disc(f32::NAN, 2.0), [0.0; 3], 1.0).map(drop))),
+        ("NaN velocity", ErrorKind::NotFinite, "velocity", Box::new(move |w| w.add_body(disc(8.0, 2.0), [f32::NAN, 0.0, 0.0], 1.0).map(drop))),
+        ("NaN e", ErrorKind::NotFinite, "e", Box::new(move |w| w.add_body(disc(8.0, 2.0), [0.0; 3], f32::NAN).map(drop))),
+        ("too fast", ErrorKind::SpeedRange, "velocity", Box::new(move |w| w.add_body(disc(8.0, 2.0), [0.8, 0.8, 0.0], 1.0).map(drop))),
+        ("e = 2", ErrorKind::RestitutionRange, "e", Box::new(move |w| w.add_body(disc(8.0, 2.0), [0.0; 3], 2.0).map(drop))),
+        ("a sphere in 2D", ErrorKind::BadDimension, "shape: a sphere in 2D", Box::new(|w| w.add_body(Shape::Sphere { centre: [8.0; 3], radius: 2.0 }, [0.0; 3], 1.0).map(drop))),
+        ("no room", ErrorKind::SurfaceTableFull, "desc.body_surface_capacity", Box::new(move |w| w.add_body(low(6.0), [0.0; 3], 1.0).map(drop))),
+        ("move: no room", ErrorKind::SurfaceTableFull, "desc.body_surface_capacity", Box::new(move |w| w.move_body(0, disc(16.0, 12.0), [0.0; 3]))),
+        ("move: unknown id", ErrorKind::NoBody, "id", Box::new(move |w| w.move_body(1, disc(8.0, 2.0), [0.0; 3]))),
+        ("move: too fast", ErrorKind::SpeedRange, "velocity", Box::new(move |w| w.move_body(0, disc(8.0, 2.0), [1.5, 0.0, 0.0]))),
+        ("remove: unknown id", ErrorKind::NoBody, "id", Box::new(|w| w.remove_body(7))),
+        ("stats: unknown id", ErrorKind::NoBody, "id", Box::new(|w| w.body_stats(1).map(drop))),
+        ("a static obstacle over a body", ErrorKind::CellObstacle, "the obstacle", Box::new(|w| w.add_shape(Shape::Box { min: [15.0, 15.0, 0.0], max: [17.0, 17.0, 0.0] }, 1.0))),
     ];
-    for (what, want, call) in &cases {
-        assert_eq!(call(w), Err(*want), "{what}");
+    for (what, kind, detail, call) in &cases {
+        assert_eq!(call(w).map_err(|e| (e.kind(), e.detail())), Err((*kind, *detail)), "{what}");
         assert!(image(w) == before, "{what}: the world changed");
     }
     // The body table full: the second slot taken, a third refused.
     w.add_body(disc(6.0, 1.5), [0.0; 3], 1.0).unwrap();
     let before = image(w);
-    assert_eq!(w.add_body(disc(26.0, 1.5), [0.0; 3], 1.0), Err(Error::BodyTableFull));
+    let full = w.add_body(disc(26.0, 1.5), [0.0; 3], 1.0).unwrap_err();
+    assert_eq!((full.kind(), full.detail()), (ErrorKind::BodyTableFull, "desc.body_capacity"));
     assert!(image(w) == before, "a full table: the world changed");
     // A world without bodies: none to add.
     let mut plain = Description::new_2d(16, 16);
     plain.obstacles = true;
     let mut mem = memory(&plain);
     let p = World::init(&plain, &mut mem).unwrap();
-    assert_eq!(p.add_body(disc(8.0, 2.0), [0.0; 3], 1.0), Err(Error::NotEnabled));
-    assert_eq!(p.body_stats(0), Err(Error::NotEnabled));
+    let none = p.add_body(disc(8.0, 2.0), [0.0; 3], 1.0).unwrap_err();
+    assert_eq!((none.kind(), none.detail()), (ErrorKind::NotEnabled, "desc.obstacles or desc.body_capacity"));
+    assert_eq!(p.body_stats(0).map_err(Error::kind), Err(ErrorKind::NotEnabled));
 }
 
 #[test]
@@ -475,7 +480,7 @@ fn the_body_surface_entries_a_shape_takes_are_known_before_it_is_added() {
                     if room == count {
                         assert_eq!(r, Ok(0), "{dim}D case {case}: {s:?} in {room}");
                     } else if count > 0 {
-                        assert_eq!(r, Err(Error::SurfaceTableFull), "{dim}D case {case}: {s:?} in {room}");
+                        assert_eq!(r.map_err(Error::kind), Err(ErrorKind::SurfaceTableFull), "{dim}D case {case}: {s:?} in {room}");
                     }
                 }
             }
@@ -487,5 +492,5 @@ fn the_body_surface_entries_a_shape_takes_are_known_before_it_is_added() {
         }
     }
     let plain = Description::new_2d(8, 8);
-    assert_eq!(plain.body_surface_entries(Shape::Disc { centre: [4.0, 4.0], radius: 2.0 }), Err(Error::NotEnabled));
+    assert_eq!(plain.body_surface_entries(Shape::Disc { centre: [4.0, 4.0], radius: 2.0 }).map_err(Error::kind), Err(ErrorKind::NotEnabled));
 }

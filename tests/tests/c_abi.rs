@@ -1150,6 +1150,17 @@ fn worlds_end_only_when_no_call_is_inside() {
     run.assert_success();
 }
 
+/// Two threads refuse descriptions for different fields at once, 20,000
+/// times each, and read their own detail (mpca_last_error) back after
+/// each: never the other thread's; a thread that has refused nothing reads
+/// "", and the main thread's detail is its own after the other ended.
+#[test]
+fn each_thread_keeps_its_own_detail() {
+    let run = threads();
+    assert_eq!(run.value("threads: details per thread: "), "20000 refusals each, 0 read back wrong", "{}", run.stdout);
+    run.assert_no_failures_in("details per thread");
+}
+
 // --- Snapshots (M12) and region counters ------------------------------------
 
 /// Refusals `snapshots.c` must try: every truncation and bit flip of its

@@ -8,7 +8,7 @@ mod common;
 
 use std::collections::HashMap;
 
-use mpca::{Description, Emitter, Error, Identity, Method, Particle, World};
+use mpca::{Description, Emitter, Error, ErrorKind, Identity, Method, Particle, World};
 use mpca_tests::scenes::every_part_with;
 
 /// What the world holds but for the identity planes.
@@ -146,7 +146,7 @@ fn without_ids_left_adds_are_refused_and_emissions_fall_short() {
     w.add_particle([2, 2, 0], [0.0; 3]).unwrap();
     assert_eq!(common::particle(w, [2, 2, 0]).id, u32::MAX);
     let hash = w.state_hash();
-    assert_eq!(w.add_particle([3, 3, 0], [0.0; 3]), Err(Error::IdsExhausted));
+    assert_eq!(w.add_particle([3, 3, 0], [0.0; 3]).map_err(Error::kind), Err(ErrorKind::IdsExhausted));
     assert_eq!((w.state_hash(), w.particle_count()), (hash, 2));
     w.add_emitter(Emitter { min: [4, 4, 0], max: [12, 12, 1], rate: 3.0, mass: 1.0, ..Emitter::default() }).unwrap();
     w.step(5);
@@ -155,7 +155,7 @@ fn without_ids_left_adds_are_refused_and_emissions_fall_short() {
     // An image whose particle holds an id above those given is refused.
     image[IDS_GIVEN_AT..IDS_GIVEN_AT + 4].copy_from_slice(&0u32.to_le_bytes());
     common::reseal(&mut image);
-    assert_eq!(w.load(&image), Err(Error::ImageInvalid));
+    assert_eq!(w.load(&image).map_err(Error::kind), Err(ErrorKind::ImageInvalid));
 }
 
 #[test]
@@ -166,8 +166,8 @@ fn the_planes_are_refused_where_the_world_has_none() {
     let w = World::init(&d, &mut memory).unwrap();
     w.add_particle([1, 1, 0], [0.0; 3]).unwrap();
     w.add_emitter(Emitter { min: [0, 0, 0], max: [2, 2, 1], rate: 0.0, mass: 1.0, ..Emitter::default() }).unwrap();
-    assert_eq!(w.set_tag([1, 1, 0], 3), Err(Error::NotEnabled));
-    assert_eq!(w.set_emitter_tag(0, 3), Err(Error::NotEnabled));
+    assert_eq!(w.set_tag([1, 1, 0], 3).map_err(Error::kind), Err(ErrorKind::NotEnabled));
+    assert_eq!(w.set_emitter_tag(0, 3).map_err(Error::kind), Err(ErrorKind::NotEnabled));
     let p = common::particle(w, [1, 1, 0]);
     assert_eq!((p.id, p.age, p.tag), (0, 0, 0));
     // Each plane costs its bytes a cell and nothing more.

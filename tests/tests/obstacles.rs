@@ -5,7 +5,7 @@
 mod common;
 
 use common::{memory, particle, quanta};
-use mpca::{Boundary, Cell, Description, Error, Quantization, Shape, World};
+use mpca::{Boundary, Cell, Description, Error, ErrorKind, Quantization, Shape, World};
 
 /// Cell centre (M7: a cell belongs to a shape when its centre does).
 fn centre(c: [u32; 3]) -> [f64; 3] {
@@ -252,13 +252,13 @@ fn thin_mask_is_refused_and_changes_nothing() {
         ("full column", (0..cells).map(|i| u8::from(i % 16 == 8)).collect::<Vec<u8>>()),
         ("segment", (0..cells).map(|i| u8::from(i % 16 == 8 && (4..12).contains(&(i / 16)))).collect()),
     ] {
-        assert_eq!(world.add_obstacle_mask(&mask, 1.0), Err(Error::UndefinedNormal), "{name}");
+        assert_eq!(world.add_obstacle_mask(&mask, 1.0).map_err(Error::kind), Err(ErrorKind::UndefinedNormal), "{name}");
         assert_eq!(world.state_hash(), hash, "{name}");
         for pos in common::cells(&desc) {
             assert!(!world.obstacle_at(pos) && world.surface(pos).is_none(), "{name}: {pos:?} changed");
         }
     }
-    assert_eq!(world.add_obstacle_mask(&[0u8; 10], 1.0), Err(Error::BadLength));
+    assert_eq!(world.add_obstacle_mask(&[0u8; 10], 1.0).map_err(Error::kind), Err(ErrorKind::BadLength));
     let thick: Vec<u8> = (0..cells).map(|i| u8::from(matches!(i % 16, 8 | 9))).collect();
     world.add_obstacle_mask(&thick, 1.0).unwrap();
     for y in 0..16 {
@@ -305,21 +305,21 @@ fn obstacles_never_cover_particles() {
     let world = World::init(&desc, &mut mem).unwrap();
     world.add_particle([8, 8, 0], [0.0; 3]).unwrap();
     let hash = world.state_hash();
-    assert_eq!(world.add_shape(Shape::Disc { centre: [8.5, 8.5], radius: 3.0 }, 1.0), Err(Error::CellOccupied));
-    assert_eq!(world.add_obstacle([8, 8, 0], [0.0, 1.0, 0.0], 1.0), Err(Error::CellOccupied));
+    assert_eq!(world.add_shape(Shape::Disc { centre: [8.5, 8.5], radius: 3.0 }, 1.0).map_err(Error::kind), Err(ErrorKind::CellOccupied));
+    assert_eq!(world.add_obstacle([8, 8, 0], [0.0, 1.0, 0.0], 1.0).map_err(Error::kind), Err(ErrorKind::CellOccupied));
     // A 3 x 3 block around the particle: thick enough for every normal.
     let mask: Vec<u8> =
         (0..256).map(|i| u8::from((7..10).contains(&(i % 16)) && (7..10).contains(&(i / 16)))).collect();
-    assert_eq!(world.add_obstacle_mask(&mask, 1.0), Err(Error::CellOccupied));
+    assert_eq!(world.add_obstacle_mask(&mask, 1.0).map_err(Error::kind), Err(ErrorKind::CellOccupied));
     for pos in common::cells(&desc) {
         assert!(!world.obstacle_at(pos), "{pos:?}");
     }
     assert_eq!(world.state_hash(), hash);
     world.add_obstacle([3, 3, 0], [1.0, 0.0, 0.0], 1.0).unwrap();
-    assert_eq!(world.add_particle([3, 3, 0], [0.0; 3]), Err(Error::CellObstacle));
-    assert_eq!(world.add_shape(Shape::Sphere { centre: [4.0; 3], radius: 2.0 }, 1.0), Err(Error::BadDimension));
-    assert_eq!(world.add_shape(Shape::Disc { centre: [4.0; 2], radius: -2.0 }, 1.0), Err(Error::BadShape));
-    assert_eq!(world.add_shape(Shape::Disc { centre: [4.0; 2], radius: 2.0 }, 1.5), Err(Error::RestitutionRange));
+    assert_eq!(world.add_particle([3, 3, 0], [0.0; 3]).map_err(Error::kind), Err(ErrorKind::CellObstacle));
+    assert_eq!(world.add_shape(Shape::Sphere { centre: [4.0; 3], radius: 2.0 }, 1.0).map_err(Error::kind), Err(ErrorKind::BadDimension));
+    assert_eq!(world.add_shape(Shape::Disc { centre: [4.0; 2], radius: -2.0 }, 1.0).map_err(Error::kind), Err(ErrorKind::BadShape));
+    assert_eq!(world.add_shape(Shape::Disc { centre: [4.0; 2], radius: 2.0 }, 1.5).map_err(Error::kind), Err(ErrorKind::RestitutionRange));
 }
 
 /// A first bounce: velocity before and after in quanta, and the cell where
@@ -510,7 +510,7 @@ fn full_surface_table_is_refused_whole() {
     let mut mem = memory(&desc);
     let world = World::init(&desc, &mut mem).unwrap();
     let big = Shape::Disc { centre: [16.0, 16.0], radius: 8.0 };
-    assert_eq!(world.add_shape(big, 1.0), Err(Error::SurfaceTableFull));
+    assert_eq!(world.add_shape(big, 1.0).map_err(Error::kind), Err(ErrorKind::SurfaceTableFull));
     for pos in common::cells(&desc) {
         assert!(!world.obstacle_at(pos) && world.surface(pos).is_none(), "{pos:?}");
     }
@@ -698,7 +698,7 @@ fn surface_entries_are_known_before_a_shape_is_added() {
                 short.surface_capacity = want - 1;
                 let mut mem = memory(&short);
                 let world = World::init(&short, &mut mem).unwrap();
-                assert_eq!(world.add_shape(shape, 1.0), Err(Error::SurfaceTableFull), "{shape:?}");
+                assert_eq!(world.add_shape(shape, 1.0).map_err(Error::kind), Err(ErrorKind::SurfaceTableFull), "{shape:?}");
                 assert!(common::cells(&short).all(|p| !world.obstacle_at(p)));
             }
         }
@@ -711,11 +711,11 @@ fn surface_entries_are_known_before_a_shape_is_added() {
     let world = World::init(&desc, &mut mem).unwrap();
     world.add_particle([8, 8, 0], [0.0; 3]).unwrap();
     let disc = Shape::Disc { centre: [8.0, 8.0], radius: 3.0 };
-    assert_eq!(world.surface_entries(disc), Err(Error::CellOccupied));
-    assert_eq!(world.add_shape(disc, 1.0), Err(Error::CellOccupied));
+    assert_eq!(world.surface_entries(disc).map_err(Error::kind), Err(ErrorKind::CellOccupied));
+    assert_eq!(world.add_shape(disc, 1.0).map_err(Error::kind), Err(ErrorKind::CellOccupied));
     // A description without obstacles has no table to size.
-    assert_eq!(Description::new_2d(16, 16).surface_entries(disc), Err(Error::NotEnabled));
-    assert_eq!(Description::new_2d(15, 16).surface_entries(disc), Err(Error::SizeOdd));
+    assert_eq!(Description::new_2d(16, 16).surface_entries(disc).map_err(Error::kind), Err(ErrorKind::NotEnabled));
+    assert_eq!(Description::new_2d(15, 16).surface_entries(disc).map_err(Error::kind), Err(ErrorKind::SizeOdd));
 }
 
 /// The sum of the shapes' entries is a capacity that holds them all, in
@@ -771,7 +771,7 @@ fn the_water_scenes_sphere_is_sized_before_its_world_is_made() {
         let r = (scene.setup)(world);
         assert_eq!(r.is_ok(), fits, "capacity {capacity}: {r:?}");
         if !fits {
-            assert_eq!(r, Err(Error::SurfaceTableFull));
+            assert_eq!(r.map_err(Error::kind), Err(ErrorKind::SurfaceTableFull));
         }
     }
 }

@@ -5,7 +5,7 @@ mod common;
 mod stability;
 
 use common::{memory, scale, Z};
-use mpca::{Boundary, Description, Error, Quantization, Shape, Stats, World};
+use mpca::{Boundary, Description, Error, ErrorKind, Quantization, Shape, Stats, World};
 use stability::*;
 
 // ------------------------------------------------------------- masses
@@ -291,10 +291,10 @@ fn restitution_outside_zero_one_is_refused() {
     for e in bad {
         let mut d = Description::new_2d(8, 8);
         d.restitution = e;
-        assert_eq!(d.validate(), Err(Error::RestitutionRange), "restitution {e}");
+        assert_eq!(d.validate().map_err(Error::kind), Err(ErrorKind::RestitutionRange), "restitution {e}");
         let mut d = Description::new_2d(8, 8);
         d.wall_restitution = e;
-        assert_eq!(d.validate(), Err(Error::RestitutionRange), "wall restitution {e}");
+        assert_eq!(d.validate().map_err(Error::kind), Err(ErrorKind::RestitutionRange), "wall restitution {e}");
     }
     let mut desc = Description::new_2d(16, 16);
     desc.obstacles = true;
@@ -308,10 +308,10 @@ fn restitution_outside_zero_one_is_refused() {
     let mut mask = vec![0u8; 256];
     mask[3 * 16 + 12] = 1;
     for e in bad {
-        assert_eq!(world.add_obstacle([12, 12, 0], [0.0, 1.0, 0.0], e), Err(Error::RestitutionRange), "add_obstacle {e}");
+        assert_eq!(world.add_obstacle([12, 12, 0], [0.0, 1.0, 0.0], e).map_err(Error::kind), Err(ErrorKind::RestitutionRange), "add_obstacle {e}");
         let disc = Shape::Disc { centre: [3.0, 12.0], radius: 1.5 };
-        assert_eq!(world.add_shape(disc, e), Err(Error::RestitutionRange), "add_shape {e}");
-        assert_eq!(world.add_obstacle_mask(&mask, e), Err(Error::RestitutionRange), "add_obstacle_mask {e}");
+        assert_eq!(world.add_shape(disc, e).map_err(Error::kind), Err(ErrorKind::RestitutionRange), "add_shape {e}");
+        assert_eq!(world.add_obstacle_mask(&mask, e).map_err(Error::kind), Err(ErrorKind::RestitutionRange), "add_obstacle_mask {e}");
         assert_eq!((world.state_hash(), world.stats(), *world.description()), before, "e = {e} changed the world");
         assert!(!world.obstacle_at([12, 12, 0]) && !world.obstacle_at([12, 3, 0]));
     }

@@ -6,7 +6,7 @@ mod common;
 mod stability;
 
 use common::{cells, memory};
-use mpca::{Cell, Description, Emitter, Error, Quantization, Shape, Vortex, World};
+use mpca::{Cell, Description, Emitter, Error, ErrorKind, Quantization, Shape, Vortex, World};
 use stability::*;
 
 // ------------------------------------------------------------- non-finite
@@ -32,10 +32,10 @@ fn non_finite_inputs_are_refused_and_change_nothing() {
             for (name, set) in fields {
                 let mut d = busy_desc(dim);
                 set(&mut d, bad);
-                assert_eq!(d.validate(), Err(Error::NotFinite), "{dim}D description {name} = {bad}");
-                assert_eq!(mpca::world_bytes(&d), Err(Error::NotFinite), "{dim}D world_bytes {name} = {bad}");
+                assert_eq!(d.validate().map_err(Error::kind), Err(ErrorKind::NotFinite), "{dim}D description {name} = {bad}");
+                assert_eq!(mpca::world_bytes(&d).map_err(Error::kind), Err(ErrorKind::NotFinite), "{dim}D world_bytes {name} = {bad}");
                 let mut poison = vec![0xa5u8; 1 << 16];
-                assert_eq!(World::init(&d, &mut poison).err(), Some(Error::NotFinite), "{dim}D init {name}");
+                assert_eq!(World::init(&d, &mut poison).err().map(Error::kind), Some(ErrorKind::NotFinite), "{dim}D init {name}");
                 assert!(poison.iter().all(|&b| b == 0xa5), "{dim}D init {name} wrote memory");
             }
         }
@@ -113,7 +113,7 @@ fn non_finite_inputs_are_refused_and_change_nothing() {
             calls.push(("set_emitter_rate".into(), world.set_emitter_rate(0, bad)));
             let mut failures = vec![];
             for (call, result) in calls {
-                if result != Err(Error::NotFinite) {
+                if result.map_err(Error::kind) != Err(ErrorKind::NotFinite) {
                     failures.push(format!("{call} = {bad}: {result:?}"));
                 }
             }
@@ -160,8 +160,8 @@ fn oversized_worlds_are_refused_without_allocating() {
     ];
     for d in too_many {
         for desc in [d, every_part(d)] {
-            assert_eq!(desc.validate(), Err(Error::TooLarge), "{:?}", desc.size);
-            assert_eq!(mpca::world_bytes(&desc), Err(Error::TooLarge), "{:?}", desc.size);
+            assert_eq!(desc.validate().map_err(Error::kind), Err(ErrorKind::TooLarge), "{:?}", desc.size);
+            assert_eq!(mpca::world_bytes(&desc).map_err(Error::kind), Err(ErrorKind::TooLarge), "{:?}", desc.size);
         }
     }
     for d in [Description::new_2d(1 << 16, 1 << 15), Description::new_3d(1 << 11, 1 << 11, 1 << 9)] {
@@ -175,7 +175,7 @@ fn oversized_worlds_are_refused_without_allocating() {
             + u128::from(u32::MAX) * std::mem::size_of::<Emitter>() as u128;
         match mpca::world_bytes(&desc) {
             Ok(bytes) => assert!(bytes as u128 >= payload && payload <= usize::MAX as u128, "{bytes} < {payload}"),
-            Err(e) => assert!(e == Error::TooLarge && payload > usize::MAX as u128 / 2, "{e:?} for a payload of {payload}"),
+            Err(e) => assert!(e == ErrorKind::TooLarge && payload > usize::MAX as u128 / 2, "{e:?} for a payload of {payload}"),
         }
     }
 }

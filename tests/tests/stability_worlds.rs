@@ -6,7 +6,7 @@ mod common;
 mod stability;
 
 use common::{cells, memory, scale};
-use mpca::{Boundary, Description, Emitter, Error, Quantization, Shape, World};
+use mpca::{Boundary, Description, Emitter, Error, ErrorKind, Quantization, Shape, World};
 use stability::*;
 
 // ------------------------------------------------------------- degenerate worlds
@@ -85,7 +85,7 @@ fn world_of_obstacles() {
             let n = cells(&desc).count();
             world.add_obstacle_mask(&vec![1u8; n], 1.0).unwrap_or_else(|e| panic!("{what}: {e:?}"));
             assert!(cells(&desc).all(|p| world.obstacle_at(p)), "{what}");
-            assert_eq!(world.add_particle([1, 1, 0], [0.0; 3]), Err(Error::CellObstacle), "{what}");
+            assert_eq!(world.add_particle([1, 1, 0], [0.0; 3]).map_err(Error::kind), Err(ErrorKind::CellObstacle), "{what}");
             let max = [desc.size[0], desc.size[1], if dim == 3 { desc.size[2] } else { 1 }];
             world.add_emitter(Emitter { min: [0; 3], max, rate: 3.0, mass: 1.0, ..Emitter::default() }).unwrap();
             for t in 1..=10u64 {

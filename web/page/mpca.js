@@ -23,11 +23,22 @@ class Mpca {
         this.size = exports.mpca_web_size();
     }
 
-    // Builds scene `kind` (SMOKE or WATER) with `seed`; throws if refused.
+    // Builds scene `kind` (SMOKE or WATER) with `seed`; throws if refused,
+    // with the status (mpca_status's number) and the field or part at fault.
     scene(kind, seed) {
         const status = this.x.mpca_web_init(kind, seed >>> 0);
-        if (status !== 0) throw new Error(`mpca: scene ${kind} refused, status ${status}`);
+        if (status !== 0) throw new Error(`mpca: scene ${kind} refused, status ${status}: ${this.lastError()}`);
         return new Scene(this, kind);
+    }
+
+    // The field or part at fault in the last refused call
+    // ("desc.emitter_capacity"), "" while none was: static text in the
+    // module's memory, read up to its NUL.
+    lastError() {
+        const at = this.x.mpca_web_error();
+        if (at === 0) return '';
+        const bytes = new Uint8Array(this.x.memory.buffer, at);
+        return new TextDecoder().decode(bytes.subarray(0, bytes.indexOf(0)));
     }
 }
 
@@ -50,7 +61,8 @@ class Scene {
         return this.m.x.mpca_web_particles(this.kind);
     }
 
-    // An emitter at cell (x, y), y up; false when the table is full.
+    // An emitter at cell (x, y), y up; false when the table is full (why:
+    // lastError of the module).
     emit(x, y) {
         return this.m.x.mpca_web_emit(this.kind, x, y) === 0;
     }

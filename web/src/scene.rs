@@ -2,7 +2,7 @@
 //! into a vortex's flow, and water poured over a disc into a walled box.
 //! A click on the page adds an emitter where it lands ([`emit`]).
 
-use mpca::{Boundary, Collisions, Description, Drag, Drift, Emitter, Error, Shape, Vortex, World};
+use mpca::{Boundary, Collisions, Description, Drag, Drift, Emitter, Error, ErrorKind, Shape, Vortex, World};
 
 /// Cells along each side.
 pub const SIZE: u32 = 128;
@@ -115,7 +115,7 @@ pub fn step(kind: Kind, world: &mut World) {
 /// is full or the cell lies outside.
 pub fn emit(kind: Kind, world: &mut World, x: u32, y: u32) -> Result<usize, Error> {
     if x >= SIZE || y >= SIZE {
-        return Err(Error::OutOfBounds);
+        return Err(Error::new(ErrorKind::OutOfBounds, c"the click is outside the scene"));
     }
     world.add_emitter(source(kind, x, y))
 }

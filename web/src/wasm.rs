@@ -2,9 +2,9 @@
 //! a static buffer each (no allocator), and an RGBA image of each. The
 //! browser runs one thread, and only these functions touch the buffers.
 
-use core::cell::UnsafeCell;
+use core::cell::{Cell, UnsafeCell};
 
-use mpca::World;
+use mpca::{Error, World};
 
 use crate::scene::{self, Kind, SIZE};
 
@@ -40,12 +40,37 @@ fn slot(kind: u32) -> Option<(Kind, &'static mut Slot)> {
     Some((k, &mut slots[kind as usize]))
 }
 
+/// The last refusal of an export, for the page to show (`mpca_web_error`).
+struct Last(Cell<Option<Error>>);
+
+// SAFETY: as for `Slots`: one thread.
+unsafe impl Sync for Last {}
+
+static LAST: Last = Last(Cell::new(None));
+
+/// Keeps `e` as the last refusal and returns its code, what the exports
+/// return for it.
+fn refused(e: Error) -> u32 {
+    LAST.0.set(Some(e));
+    e.code()
+}
+
+/// The detail of the last refusal (the field or part at fault, beside
+/// the code the export returned): the address of static, NUL-terminated
+/// text in the module's memory, or 0 while no export was refused. The
+/// kinds' messages are left out of the module: the code says the kind.
+#[unsafe(no_mangle)]
+pub extern "C" fn mpca_web_error() -> *const u8 {
+    LAST.0.get().map_or(core::ptr::null(), |e| e.c_detail().as_ptr().cast())
+}
+
 /// The world of a slot, if built.
 fn world(s: &mut Slot) -> Option<&mut World> {
     s.world.as_deref_mut()
 }
 
-/// Builds scene `kind` with `seed`; 0 on success, else the error's code.
+/// Builds scene `kind` with `seed`; 0 on success, else the error's code
+/// (its text: `mpca_web_error`).
 #[unsafe(no_mangle)]
 pub extern "C" fn mpca_web_init(kind: u32, seed: u32) -> u32 {
     let Some((k, s)) = slot(kind) else { return 1 };
@@ -59,7 +84,7 @@ pub extern "C" fn mpca_web_init(kind: u32, seed: u32) -> u32 {
             s.world = Some(w);
             0
         }
-        Err(e) => e as u32,
+        Err(e) => refused(e),
     }
 }
 
@@ -97,14 +122,15 @@ pub extern "C" fn mpca_web_render(kind: u32) -> *const u8 {
     s.pixels.as_ptr()
 }
 
-/// An emitter at cell (x, y) of scene `kind`; 0 on success.
+/// An emitter at cell (x, y) of scene `kind`; 0 on success, else the
+/// error's code (its text: `mpca_web_error`).
 #[unsafe(no_mangle)]
 pub extern "C" fn mpca_web_emit(kind: u32, x: u32, y: u32) -> u32 {
     let Some((k, s)) = slot(kind) else { return 1 };
     let Some(w) = world(s) else { return 1 };
     match scene::emit(k, w, x, y) {
         Ok(_) => 0,
-        Err(e) => e as u32,
+        Err(e) => refused(e),
     }
 }
 

@@ -11,7 +11,9 @@
 //! of them share stay out of line (`#[inline(never)]`), one copy each, so
 //! that the C library that holds them stays small.
 
-use crate::Error;
+use core::ffi::CStr;
+
+use crate::{Error, ErrorKind};
 use crate::rules::body::{for_ring, pushed_velocity, Body, BodiesHead, BodySurface, Tally};
 use crate::rules::class::Class;
 use crate::rules::faces::Beyond;
@@ -118,6 +120,9 @@ impl Draw<'_> {
     }
 }
 
+/// The detail of a world or description without bodies asked for one.
+const NO_BODIES: &CStr = c"desc.obstacles or desc.body_capacity";
+
 impl crate::Description {
     /// The body surface entries (M13) a body of `shape` takes alone, where
     /// the shape lies, in a world of this description: what
@@ -132,7 +137,7 @@ impl crate::Description {
     pub fn body_surface_entries(&self, shape: Shape) -> Result<u32, Error> {
         let l = self.plan()?;
         if !self.has_bodies() {
-            return Err(Error::NotEnabled);
+            return Err(Error::new(ErrorKind::NotEnabled, NO_BODIES));
         }
         let dim = self.dim as usize;
         let body = Body::new(shape, [0.0; 3], 1.0, dim)?;
@@ -147,7 +152,7 @@ impl World {
     /// bodies (M13: `obstacles` and a `body_capacity`).
     fn bodies(&self) -> Result<(BodiesHead, &[Body]), Error> {
         if !self.head.desc.has_bodies() {
-            return Err(Error::NotEnabled);
+            return Err(Error::new(ErrorKind::NotEnabled, NO_BODIES));
         }
         let bytes = self.plane_bytes(self.layout().bodies());
         let (head, table) = bytes.split_at(core::mem::size_of::<BodiesHead>());
@@ -167,7 +172,7 @@ impl World {
     /// surface table would not hold the cells.
     pub fn add_body(&mut self, shape: Shape, u: [f32; 3], e: f32) -> Result<u32, Error> {
         let (_, table) = self.bodies()?;
-        let slot = table.iter().position(|b| b.kind == 0).ok_or(Error::BodyTableFull)?;
+        let slot = table.iter().position(|b| b.kind == 0).ok_or(Error::new(ErrorKind::BodyTableFull, c"desc.body_capacity"))?;
         let body = self.with_fine_velocity(Body::new(shape, u, e, self.dim())?);
         self.redraw(Change { slot, body })?;
         Ok(slot as u32)
@@ -247,7 +252,7 @@ impl World {
     /// Body `id`, or `NoBody`.
     fn body(&self, id: u32) -> Result<Body, Error> {
         let (_, table) = self.bodies()?;
-        table.get(id as usize).filter(|b| b.kind != 0).copied().ok_or(Error::NoBody)
+        table.get(id as usize).filter(|b| b.kind != 0).copied().ok_or(Error::new(ErrorKind::NoBody, c"id"))
     }
 
     /// Fine units to a unit speed (M1c's `W`).
@@ -291,7 +296,7 @@ impl World {
     /// order and the particles in body cells pushed out.
     fn redraw(&mut self, change: Change) -> Result<(), Error> {
         if self.with_draw(change, |d| d.entries()) > self.head.desc.body_surface_capacity as usize {
-            return Err(Error::SurfaceTableFull);
+            return Err(Error::new(ErrorKind::SurfaceTableFull, c"desc.body_surface_capacity"));
         }
         head_and_bodies(self.planes::<u8>().1.bodies).1[change.slot] = change.body;
         self.refresh_bodies();

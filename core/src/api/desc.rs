@@ -2,7 +2,9 @@
 //! ([`Description::check`]), made in full before any memory is touched;
 //! the memory plan that follows from it is `storage/layout.rs`'s.
 
-use crate::Error;
+use core::ffi::CStr;
+
+use crate::{Error, ErrorKind};
 use crate::rules::assign::Method;
 use crate::api::checks::{finite, mass, negative, positive, restitution};
 
@@ -386,59 +388,65 @@ impl Description {
     /// force parameter, then the parts this build leaves out. What passes
     /// is what a plan is made from.
     pub(crate) fn check(&self) -> Result<Checked<'_>, Error> {
+        use ErrorKind as K;
         let dim = self.dim as usize;
         if dim != 2 && dim != 3 {
-            return Err(Error::BadDimension);
+            return Err(Error::new(K::BadDimension, c"desc.dim"));
         }
         if dim == 3 && !cfg!(feature = "dim3") {
-            return Err(Error::Dim3Disabled);
+            return Err(Error::new(K::Dim3Disabled, c"desc.dim"));
         }
         for k in 0..dim {
+            // Each axis named: the details are static text.
+            let axis = |x: &'static CStr, y: &'static CStr, z: &'static CStr| match k {
+                0 => x,
+                1 => y,
+                _ => z,
+            };
             let s = self.size[k];
-            if s == 0 {
-                return Err(Error::SizeZero);
-            }
-            if s % 2 != 0 {
-                return Err(Error::SizeOdd);
+            if s == 0 || s % 2 != 0 {
+                let kind = if s == 0 { K::SizeZero } else { K::SizeOdd };
+                return Err(Error::new(kind, axis(c"desc.size[0]", c"desc.size[1]", c"desc.size[2]")));
             }
             if self.boundary[k][0] != self.boundary[k][1]
                 && (self.boundary[k][0] == Boundary::Periodic || self.boundary[k][1] == Boundary::Periodic)
             {
-                return Err(Error::PeriodicMismatch);
+                return Err(Error::new(K::PeriodicMismatch, axis(c"desc.boundary[0]", c"desc.boundary[1]", c"desc.boundary[2]")));
             }
         }
         // M1: masses, restitutions, dt and every force parameter.
-        mass(self.mass)?;
-        restitution(self.restitution)?;
-        restitution(self.wall_restitution)?;
-        finite(&[self.dt])?;
+        mass(self.mass, c"desc.mass")?;
+        restitution(self.restitution, c"desc.restitution")?;
+        restitution(self.wall_restitution, c"desc.wall_restitution")?;
+        finite(&[self.dt], c"desc.dt")?;
         if negative(self.dt) {
-            return Err(Error::NegativeDt);
+            return Err(Error::new(K::NegativeDt, c"desc.dt"));
         }
-        finite(&self.gravity)?;
-        finite(&[self.vortex.centre[0], self.vortex.centre[1], self.vortex.core_radius, self.vortex.circulation])?;
+        finite(&self.gravity, c"desc.gravity")?;
+        finite(&[self.vortex.centre[0], self.vortex.centre[1], self.vortex.core_radius, self.vortex.circulation], c"desc.vortex")?;
         if self.forces.vortex && !positive(self.vortex.core_radius) {
-            return Err(Error::BadVortex);
+            return Err(Error::new(K::BadVortex, c"desc.vortex.core_radius"));
         }
         // M5.1b: a rate of 0 is off, and the wind is a velocity.
-        finite(&[self.drag.rate])?;
-        finite(&self.drag.wind)?;
+        finite(&[self.drag.rate], c"desc.drag.rate")?;
+        finite(&self.drag.wind, c"desc.drag.wind")?;
         if negative(self.drag.rate) {
-            return Err(Error::BadDrag);
+            return Err(Error::new(K::BadDrag, c"desc.drag.rate"));
         }
         if !crate::api::speed::slow(&self.drag.wind[..dim]) {
-            return Err(Error::SpeedRange);
+            return Err(Error::new(K::SpeedRange, c"desc.drag.wind"));
         }
         if self.drag.vortex && positive(self.drag.rate) && !positive(self.vortex.core_radius) {
-            return Err(Error::BadVortex);
+            return Err(Error::new(K::BadVortex, c"desc.vortex.core_radius"));
         }
         if self.quantization == Quantization::Bits16 && !cfg!(feature = "q16") {
-            return Err(Error::Q16Disabled);
+            return Err(Error::new(K::Q16Disabled, c"desc.quantization"));
         }
         // A part the build left out: the step reads the description through
         // accessors that give what the build keeps (`has_masses`,
         // `built_forces`, `assignment`, ...), so a description they would
-        // change asks for something missing. One map of features to parts.
+        // change asks for something missing. One map of features to parts;
+        // which part, only once one is missing.
         let kept = self.has_masses() == self.per_particle_mass
             && self.has_obstacles() == self.obstacles
             && self.built_forces() == self.forces
@@ -451,12 +459,49 @@ impl Description {
             && self.has_energy_neutral() == self.energy_neutral
             && self.identity_planes().any() == self.identity.any();
         if !kept {
-            return Err(Error::FeatureDisabled);
+            return Err(Error::computed(K::FeatureDisabled, || self.left_out()));
         }
         if self.per_particle_mass && !(1..=256).contains(&self.mass_classes) {
-            return Err(Error::CapacityRange);
+            return Err(Error::new(K::CapacityRange, c"desc.mass_classes"));
         }
         Ok(Checked(self))
+    }
+
+    /// The field that asks for a part this build left out, and the feature
+    /// that builds it in, for [`Description::check`]'s refusal: the same
+    /// map as its, field by field. Out of line and apart, so the check
+    /// itself stays one test.
+    #[inline(never)]
+    #[cold]
+    fn left_out(&self) -> &'static CStr {
+        let f = self.forces;
+        if self.has_masses() != self.per_particle_mass {
+            c"desc.per_particle_mass needs feature `mass`"
+        } else if self.has_obstacles() != self.obstacles {
+            c"desc.obstacles needs feature `obstacles`"
+        } else if self.built_forces().vortex != f.vortex {
+            c"desc.forces.vortex needs feature `vortex`"
+        } else if self.built_forces().field != f.field {
+            c"desc.forces.field needs feature `fields`"
+        } else if self.built_forces().potential != f.potential {
+            c"desc.forces.potential needs feature `fields`"
+        } else if self.has_drag() != positive(self.drag.rate) {
+            c"desc.drag.rate needs feature `fields`"
+        } else if !cfg!(feature = "fields") && self.drag.field {
+            c"desc.drag.field needs feature `fields`"
+        } else if self.assignment() != self.method {
+            c"desc.method needs feature `all-methods`"
+        } else if self.collision_rule() != self.collisions {
+            c"desc.collisions needs feature `collision-rules`"
+        } else if self.has_contacts() != self.contacts {
+            c"desc.contacts needs feature `collision-rules`"
+        } else if self.has_rest() != self.rest {
+            c"desc.rest needs feature `collision-rules`"
+        } else if self.has_energy_neutral() != self.energy_neutral {
+            c"desc.energy_neutral needs feature `collision-rules`"
+        } else {
+            c"desc.identity needs feature `identity`"
+        }
     }
 
     /// `per_particle_mass`, false by construction in a build without the
@@ -569,26 +614,37 @@ mod tests {
         // Expect: a description asking for an assignment method, a
         // collision rule or a force the build left out (without the
         // features `all-methods`, `collision-rules`, `vortex`, `fields`) is
-        // refused with FeatureDisabled, and accepted by a
-        // build that has it (the default); the paper's rules and
-        // exact-fast are accepted by every build.
-        let want = |left_out: bool| if left_out { Err(Error::FeatureDisabled) } else { Ok(()) };
+        // refused with FeatureDisabled, its detail naming the field that
+        // asks for it and the feature, and accepted by a build that has it
+        // (the default); the paper's rules and exact-fast are accepted by
+        // every build.
+        let check = |d: Description, left_out: bool, detail: &str| match d.validate() {
+            Ok(()) => assert!(!left_out, "{detail}: accepted"),
+            Err(e) => {
+                assert!(left_out, "{detail}: refused, {e}");
+                assert_eq!(e.kind(), ErrorKind::FeatureDisabled);
+                if cfg!(feature = "details") {
+                    assert_eq!(e.detail(), detail);
+                }
+            }
+        };
         let plain = Description::new_2d(8, 8);
         for method in [Method::Exhaustive, Method::Greedy] {
-            let d = Description { method, ..plain };
-            assert_eq!(d.validate(), want(!cfg!(feature = "all-methods")), "{method:?}");
+            check(Description { method, ..plain }, !cfg!(feature = "all-methods"), "desc.method needs feature `all-methods`");
         }
-        let paper_only = want(!cfg!(feature = "collision-rules"));
-        assert_eq!(Description { collisions: Collisions::SpeedLimited, ..plain }.validate(), paper_only, "M5.2b");
-        assert_eq!(Description { contacts: true, ..plain }.validate(), paper_only, "M5.7");
-        assert_eq!(Description { rest: true, ..plain }.validate(), paper_only, "M5.7b");
-        assert_eq!(Description { energy_neutral: true, ..plain }.validate(), paper_only, "M1b");
+        let paper_only = !cfg!(feature = "collision-rules");
+        check(Description { collisions: Collisions::SpeedLimited, ..plain }, paper_only, "desc.collisions needs feature `collision-rules`");
+        check(Description { contacts: true, ..plain }, paper_only, "desc.contacts needs feature `collision-rules`");
+        check(Description { rest: true, ..plain }, paper_only, "desc.rest needs feature `collision-rules`");
+        check(Description { energy_neutral: true, ..plain }, paper_only, "desc.energy_neutral needs feature `collision-rules`");
         // The vortex needs `vortex` (which `fields` implies), the other
         // summed forces and drag need `fields`.
         let vortex = Forces { vortex: true, ..plain.forces };
-        assert_eq!(Description { forces: vortex, ..plain }.validate(), want(!cfg!(feature = "vortex")), "vortex");
+        check(Description { forces: vortex, ..plain }, !cfg!(feature = "vortex"), "desc.forces.vortex needs feature `vortex`");
         let field = Forces { field: true, ..plain.forces };
-        assert_eq!(Description { forces: field, ..plain }.validate(), want(!cfg!(feature = "fields")), "force field");
+        check(Description { forces: field, ..plain }, !cfg!(feature = "fields"), "desc.forces.field needs feature `fields`");
+        let wind_field = Drag { field: true, ..plain.drag };
+        check(Description { drag: wind_field, ..plain }, !cfg!(feature = "fields"), "desc.drag.field needs feature `fields`");
         assert_eq!(plain.validate(), Ok(()));
     }
 }

@@ -2,7 +2,9 @@
 //! own), removing one, and the placement the emitters share (M1, M6, M9).
 //! Every edit checks everything before it changes anything.
 
-use crate::Error;
+use core::ffi::CStr;
+
+use crate::{Error, ErrorKind};
 use crate::api::query::Particle;
 use crate::rules::quant::{with_quant, Quant};
 use crate::storage::cells::Cells;
@@ -35,30 +37,30 @@ impl World {
     /// [`storable`]. That takes every `|v| <= 1` and every velocity a world
     /// reports, so a world can be rebuilt from what it reports.
     pub(crate) fn check_velocity(&self, v: [f32; 3]) -> Result<[f32; 3], Error> {
-        crate::api::checks::finite(&v)?;
+        crate::api::checks::finite(&v, c"velocity")?;
         let mut v = v;
         if self.dim() == 2 {
             v[2] = 0.0;
         }
         if v.iter().any(|c| c.abs() > 1.0) {
-            return Err(Error::SpeedRange);
+            return Err(Error::new(ErrorKind::SpeedRange, c"velocity"));
         }
         let ok = with_quant!(self.head.desc.quantization, Q => {
             storable(v.map(|c| Q::nearest(c).to_int()), Q::SCALE as i32)
         });
         if !ok {
-            return Err(Error::SpeedRange);
+            return Err(Error::new(ErrorKind::SpeedRange, c"velocity"));
         }
         Ok(v)
     }
 
     /// The mass table index of `m`, adding it if new. Nothing is changed on
-    /// error.
-    pub(crate) fn mass_index_of(&mut self, m: f32) -> Result<u8, Error> {
-        crate::api::checks::mass(m)?;
+    /// error. `of` says where the mass came from, for the details.
+    pub(crate) fn mass_index_of(&mut self, m: f32, of: MassOf) -> Result<u8, Error> {
+        crate::api::checks::mass(m, of.field())?;
         if !self.head.desc.has_masses() {
             // Both positive (checked): equal exactly where their bits are.
-            return if m.to_bits() == self.head.desc.mass.to_bits() { Ok(0) } else { Err(Error::NotEnabled) };
+            return if m.to_bits() == self.head.desc.mass.to_bits() { Ok(0) } else { Err(Error::computed(ErrorKind::NotEnabled, || of.not_one())) };
         }
         let used = self.head.masses as usize;
         let (head, p) = self.planes::<u8>();
@@ -67,7 +69,7 @@ impl World {
         }
         // The plane holds the step's classes after the table (`mass_plane`).
         if used >= head.desc.mass_classes as usize {
-            return Err(Error::MassTableFull);
+            return Err(Error::new(ErrorKind::MassTableFull, c"desc.mass_classes"));
         }
         p.mass_table[used] = m;
         head.masses += 1;
@@ -81,23 +83,24 @@ impl World {
         self.add_particle_with_mass(pos, v, m)
     }
 
+
     /// Adds a particle of mass `m`. Worlds without per-particle masses accept
     /// only their own mass.
     pub fn add_particle_with_mass(&mut self, pos: [u32; 3], v: [f32; 3], m: f32) -> Result<(), Error> {
         let s = self.locate(pos)?;
         let v = self.check_velocity(v)?;
         if self.occupied(s) {
-            return Err(Error::CellOccupied);
+            return Err(Error::new(ErrorKind::CellOccupied, c"pos"));
         }
         if self.is_obstacle(s) {
-            return Err(Error::CellObstacle);
+            return Err(Error::new(ErrorKind::CellObstacle, c"pos"));
         }
         if self.ids_left() == 0 {
-            return Err(Error::IdsExhausted);
+            return Err(Error::new(ErrorKind::IdsExhausted, c"ids"));
         }
         // Last fallible step (it checks the mass first); it changes the
         // world only when it succeeds.
-        let index = self.mass_index_of(m)?;
+        let index = self.mass_index_of(m, MassOf::Particle)?;
         self.place_added(s, v, index);
         self.head.counters.particles += 1;
         Ok(())
@@ -190,10 +193,10 @@ impl World {
     pub fn set_tag(&mut self, pos: [u32; 3], tag: u8) -> Result<(), Error> {
         let s = self.locate(pos)?;
         if !self.head.desc.identity_planes().tags() {
-            return Err(Error::NotEnabled);
+            return Err(Error::new(ErrorKind::NotEnabled, NO_TAGS));
         }
         if !self.occupied(s) {
-            return Err(Error::NoParticle);
+            return Err(Error::new(ErrorKind::NoParticle, NO_PARTICLE));
         }
         #[cfg(feature = "identity")]
         {
@@ -208,7 +211,7 @@ impl World {
     pub fn remove_particle(&mut self, pos: [u32; 3]) -> Result<Particle, Error> {
         let s = self.locate(pos)?;
         if !self.occupied(s) {
-            return Err(Error::NoParticle);
+            return Err(Error::new(ErrorKind::NoParticle, NO_PARTICLE));
         }
         let p = self.particle_at(pos, s.cell);
         let (head, planes) = self.planes::<u8>();
@@ -217,6 +220,39 @@ impl World {
         Ok(p)
     }
 }
+
+/// Where a mass came from, which the details of its refusal name: a tag
+/// rather than the texts, so that a build without details, where the
+/// texts go unused, references none of them.
+#[derive(Clone, Copy)]
+pub(crate) enum MassOf {
+    Particle,
+    Emitter,
+}
+
+impl MassOf {
+    /// The field: not finite, or not above 0.
+    fn field(self) -> &'static CStr {
+        match self {
+            MassOf::Particle => c"mass",
+            MassOf::Emitter => c"emitter.mass",
+        }
+    }
+
+    /// Another mass than the world's, in a world of one.
+    fn not_one(self) -> &'static CStr {
+        match self {
+            MassOf::Particle => c"mass is not desc.mass (desc.per_particle_mass is off)",
+            MassOf::Emitter => c"emitter.mass is not desc.mass (desc.per_particle_mass is off)",
+        }
+    }
+}
+
+/// The detail of a cell a call needs a particle in.
+const NO_PARTICLE: &CStr = c"pos";
+
+/// The detail of a world without tags asked to set one.
+pub(crate) const NO_TAGS: &CStr = c"desc.identity (no tags)";
 
 /// A velocity as [`World::place`] takes it: a caller's floats (rounded to
 /// nearest), or an emitter's fine units (rounded stochastically, M1c).
@@ -268,7 +304,7 @@ mod tests {
         assert!(p.velocity[0] * p.velocity[0] + p.velocity[1] * p.velocity[1] > 1.0);
         w.add_particle([1, 1, 0], p.velocity).unwrap();
         assert_eq!(w.remove_particle([1, 1, 0]).unwrap(), p);
-        assert_eq!(w.add_particle([1, 1, 0], [1.0001, 0.0, 0.0]), Err(Error::SpeedRange));
-        assert_eq!(w.add_particle([1, 1, 0], [0.8, 0.7, 0.0]), Err(Error::SpeedRange));
+        assert_eq!(w.add_particle([1, 1, 0], [1.0001, 0.0, 0.0]).map_err(Error::kind), Err(ErrorKind::SpeedRange));
+        assert_eq!(w.add_particle([1, 1, 0], [0.8, 0.7, 0.0]).map_err(Error::kind), Err(ErrorKind::SpeedRange));
     }
 }

@@ -1,21 +1,24 @@
-//! Errors are values (STYLE.md practice 3): every refusal names its cause,
-//! and the world is left exactly as it was.
+//! Errors are values (STYLE.md practice 3): every refusal says what kind
+//! of problem it is and names the field or part at fault, and the world is
+//! left exactly as it was.
 
+#[cfg(feature = "details")]
+use core::ffi::c_char;
 use core::ffi::CStr;
 use core::fmt;
 
-/// Why the library refused a request. Nothing was changed when one of these
-/// is returned.
+/// What kind of problem made the library refuse a request: the part of an
+/// [`Error`] a program matches on.
 ///
-/// Each variant carries a number ([`Error::code`]) that the C ABI returns as
-/// its `mpca_status`. Numbers are never reused or changed: a new error takes
-/// a new one. 2 and 6 are shared with statuses the C ABI also returns for
-/// its own checks (a bad handle, a short output buffer); the rest lie in
-/// 100..199.
+/// Each kind carries a number ([`ErrorKind::code`]) that the C ABI returns
+/// as its `mpca_status`. Numbers are never reused or changed: a new kind
+/// takes a new one. 2 and 6 are shared with statuses the C ABI also
+/// returns for its own checks (a bad handle, a short output buffer); the
+/// rest lie in 100..199.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 #[non_exhaustive]
 #[repr(u32)]
-pub enum Error {
+pub enum ErrorKind {
     /// The dimension is neither 2 nor 3.
     BadDimension = 100,
     /// 3D worlds need the `dim3` feature, which this build left out.
@@ -115,21 +118,21 @@ pub enum Error {
     NoBody = 143,
 }
 
-/// The one table of messages. It writes both [`Error::c_message`], whose
-/// match must name every variant, and [`Error::ALL`], so a variant cannot be
-/// added without being listed.
+/// The one table of messages. It writes both [`ErrorKind::c_message`],
+/// whose match must name every variant, and [`ErrorKind::ALL`], so a
+/// variant cannot be added without being listed.
 macro_rules! messages {
     ($($variant:ident => $text:literal,)*) => {
-        impl Error {
-            /// Every error, in declaration order: for the C ABI's check that
+        impl ErrorKind {
+            /// Every kind, in declaration order: for the C ABI's check that
             /// each one has its status.
-            pub const ALL: &'static [Error] = &[$(Error::$variant),*];
+            pub const ALL: &'static [ErrorKind] = &[$(ErrorKind::$variant),*];
 
-            /// A short, static description of the error, NUL-terminated so
+            /// A short, static description of the kind, NUL-terminated so
             /// the C ABI hands out the same bytes without copying.
             pub const fn c_message(self) -> &'static CStr {
                 match self {
-                    $(Error::$variant => $text,)*
+                    $(ErrorKind::$variant => $text,)*
                 }
             }
         }
@@ -183,13 +186,13 @@ messages! {
     NoBody => c"no body has this id",
 }
 
-impl Error {
-    /// The error's stable number, the `mpca_status` the C ABI returns for it.
+impl ErrorKind {
+    /// The kind's stable number, the `mpca_status` the C ABI returns for it.
     pub const fn code(self) -> u32 {
         self as u32
     }
 
-    /// A short, static description of the error.
+    /// A short, static description of the kind.
     pub const fn message(self) -> &'static str {
         match self.c_message().to_str() {
             Ok(text) => text,
@@ -199,9 +202,147 @@ impl Error {
     }
 }
 
-impl fmt::Display for Error {
+impl fmt::Display for ErrorKind {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(self.message())
+    }
+}
+
+/// Why the library refused a request: its [`kind`](Error::kind), what is
+/// wrong, to match on, and a [`detail`](Error::detail) that names where:
+/// the field, argument or part at fault, with what is wrong with it where
+/// the kind does not say (`desc.size[1]`, `desc.emitter_capacity is 0`).
+/// Nothing was changed when one of these is returned.
+///
+/// ```
+/// use mpca::{Description, ErrorKind};
+///
+/// let e = Description::new_2d(8, 7).validate().unwrap_err();
+/// assert_eq!(e.kind(), ErrorKind::SizeOdd);
+/// assert_eq!(e.detail(), "desc.size[1]");
+/// assert_eq!(e.to_string(), "a world size is odd; Margolus blocks need even sizes: desc.size[1]");
+/// ```
+///
+/// The detail is static text: an error is made without allocating, and is
+/// `Copy`. Two errors are equal when their kinds and details are. A build
+/// without the feature `details` (firmware, where flash is short) keeps
+/// the kind alone, and gives its message as the detail.
+#[derive(Clone, Copy)]
+pub struct Error {
+    kind: ErrorKind,
+    /// NUL-terminated static text, held by its start alone, so that the
+    /// results of the many calls that refuse stay small, and the C ABI
+    /// hands the same bytes out.
+    #[cfg(feature = "details")]
+    detail: *const c_char,
+}
+
+// SAFETY: `detail` points at static text that is never written: sharing it
+// between threads is sharing a `&'static CStr`.
+unsafe impl Send for Error {}
+// SAFETY: as for Send.
+unsafe impl Sync for Error {}
+
+impl Error {
+    /// An error of kind `kind`, with `detail` naming where it is: a
+    /// field (`desc.drag.rate`), an argument (`pos`), or a part of an
+    /// image (`surface table`), and what is wrong with it where the kind
+    /// does not say (`desc.emitter_capacity is 0`).
+    #[inline(always)]
+    pub const fn new(kind: ErrorKind, detail: &'static CStr) -> Error {
+        #[cfg(feature = "details")]
+        return Error { kind, detail: detail.as_ptr() };
+        #[cfg(not(feature = "details"))]
+        {
+            let _ = detail;
+            Error { kind }
+        }
+    }
+
+    /// An error whose detail `detail` works out, where it takes more than
+    /// a literal: called only in a build that keeps details.
+    #[inline(always)]
+    pub(crate) fn computed(kind: ErrorKind, detail: impl FnOnce() -> &'static CStr) -> Error {
+        #[cfg(feature = "details")]
+        return Error::new(kind, detail());
+        #[cfg(not(feature = "details"))]
+        {
+            let _ = detail;
+            Error { kind }
+        }
+    }
+
+    /// What kind of problem it is.
+    pub const fn kind(self) -> ErrorKind {
+        self.kind
+    }
+
+    /// The kind's stable number, the `mpca_status` the C ABI returns.
+    pub const fn code(self) -> u32 {
+        self.kind.code()
+    }
+
+    /// The kind's message ([`ErrorKind::message`]).
+    pub const fn message(self) -> &'static str {
+        self.kind.message()
+    }
+
+    /// The detail, NUL-terminated: what the C ABI's last-error functions
+    /// hand out.
+    pub const fn c_detail(self) -> &'static CStr {
+        #[cfg(feature = "details")]
+        // SAFETY: `detail` came from a `&'static CStr` (`Error::new`): NUL-
+        // terminated, valid and never written for the program's life.
+        return unsafe { CStr::from_ptr(self.detail) };
+        #[cfg(not(feature = "details"))]
+        self.kind.c_message()
+    }
+
+    /// Where the problem is: the field, argument or part at fault, and
+    /// what is wrong with it where the kind does not say.
+    pub const fn detail(self) -> &'static str {
+        match self.c_detail().to_str() {
+            Ok(text) => text,
+            // The library's details are ASCII; another crate's might not be.
+            Err(_) => "",
+        }
+    }
+}
+
+impl PartialEq for Error {
+    fn eq(&self, other: &Error) -> bool {
+        self.kind == other.kind && self.c_detail() == other.c_detail()
+    }
+}
+
+impl Eq for Error {}
+
+impl core::hash::Hash for Error {
+    fn hash<H: core::hash::Hasher>(&self, state: &mut H) {
+        self.kind.hash(state);
+        self.c_detail().hash(state);
+    }
+}
+
+/// An error is of its kind: `error == ErrorKind::SizeOdd`.
+impl PartialEq<ErrorKind> for Error {
+    fn eq(&self, kind: &ErrorKind) -> bool {
+        self.kind == *kind
+    }
+}
+
+impl fmt::Debug for Error {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("Error").field("kind", &self.kind).field("detail", &self.c_detail()).finish()
+    }
+}
+
+/// The kind's message, then the detail: `a world size is odd; Margolus
+/// blocks need even sizes: desc.size[1]`. Without details (the feature
+/// `details` off), the message alone.
+impl fmt::Display for Error {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if cfg!(feature = "details") { write!(f, "{}: {}", self.message(), self.detail()) } else { f.write_str(self.message()) }
     }
 }
 
@@ -210,22 +351,50 @@ impl core::error::Error for Error {}
 // Every message is UTF-8, so `message` never falls back to "".
 const _: () = {
     let mut i = 0;
-    while i < Error::ALL.len() {
-        assert!(Error::ALL[i].c_message().to_str().is_ok());
+    while i < ErrorKind::ALL.len() {
+        assert!(ErrorKind::ALL[i].c_message().to_str().is_ok());
         i += 1;
     }
 };
 
 #[cfg(test)]
 mod tests {
-    use super::Error;
+    extern crate std;
+
+    use core::ffi::CStr;
+
+    use super::{Error, ErrorKind};
+
+    #[test]
+    fn an_error_is_its_kind_and_its_detail() {
+        // Expect: two errors of one kind are equal where their details are
+        // (not their addresses), of their kind either way; Display is the
+        // kind's message, then the detail (the message alone without
+        // details).
+        let a = Error::new(ErrorKind::NotFinite, c"desc.gravity");
+        let b = Error::new(ErrorKind::NotFinite, c"velocity");
+        // The same text at another address.
+        static GRAVITY: [u8; 13] = *b"desc.gravity\0";
+        let same = Error::new(ErrorKind::NotFinite, CStr::from_bytes_with_nul(&GRAVITY).unwrap());
+        assert!(a == ErrorKind::NotFinite && b == ErrorKind::NotFinite);
+        assert_eq!(a.code(), ErrorKind::NotFinite.code());
+        if cfg!(feature = "details") {
+            assert_ne!(a, b);
+            assert_eq!(a, same);
+            assert_eq!(std::format!("{b}"), "a floating-point input is NaN or infinite: velocity");
+            assert_eq!(b.c_detail(), c"velocity");
+        } else {
+            assert_eq!((a, b.detail()), (same, b.message()));
+            assert_eq!(std::format!("{b}"), b.message());
+        }
+    }
 
     #[test]
     fn numbers_and_messages_are_distinct() {
-        for (i, a) in Error::ALL.iter().enumerate() {
+        for (i, a) in ErrorKind::ALL.iter().enumerate() {
             assert!(!a.message().is_empty(), "{a:?} has no message");
             assert_eq!(a.c_message().to_bytes(), a.message().as_bytes());
-            for b in &Error::ALL[..i] {
+            for b in &ErrorKind::ALL[..i] {
                 assert_ne!(a.code(), b.code(), "{a:?} and {b:?} share a number");
                 assert_ne!(a.message(), b.message(), "{a:?} and {b:?} share a message");
             }

@@ -3,7 +3,9 @@
 //! when an addition is refused; and the entries a shape takes, asked before
 //! it is added (of a world, or of a description before its world is made).
 
-use crate::Error;
+use core::ffi::CStr;
+
+use crate::{Error, ErrorKind};
 use crate::api::checks::{finite, restitution};
 use crate::api::desc::{Boundary, Description};
 use crate::rules::faces::{resolve, Beyond};
@@ -12,6 +14,11 @@ use crate::rules::vector::normalise;
 use crate::storage::cells::Cells;
 use crate::storage::layout::put_bit;
 use crate::storage::world::World;
+
+/// The detail of a world or description without obstacles asked for them.
+const NO_OBSTACLES: &CStr = c"desc.obstacles";
+/// The detail of a refused obstacle or body restitution.
+pub(crate) const E: &CStr = c"e";
 
 /// A set of cells, as a predicate on coordinates.
 pub(crate) type Mask<'a> = &'a dyn Fn([usize; 3]) -> bool;
@@ -177,19 +184,19 @@ impl Before<'_> {
         let mut added = 0usize;
         a.each(&mut |c| {
             if (self.occupied)(c) {
-                return Err(Error::CellOccupied);
+                return Err(Error::new(ErrorKind::CellOccupied, c"the obstacle"));
             }
             if (self.body)(c) {
-                return Err(Error::CellObstacle);
+                return Err(Error::new(ErrorKind::CellObstacle, c"the obstacle"));
             }
             if frame.is_surface(c, &after) {
-                normalise((a.normal)(frame, c, &after)).ok_or(Error::UndefinedNormal)?;
+                normalise((a.normal)(frame, c, &after)).ok_or(Error::new(ErrorKind::UndefinedNormal, c"a surface cell of the obstacle"))?;
                 added += usize::from(surface_at(self.table, (self.cell)(c)).is_none());
             }
             frame.for_old_neighbours(a, self.obstacle, c, &mut |nb| {
                 let old = surface_at(self.table, (self.cell)(nb));
                 if old.is_some_and(|s| s.from_mask != 0) && frame.is_surface(nb, &after) {
-                    normalise(frame.mask_normal(nb, &after)).ok_or(Error::UndefinedNormal)?;
+                    normalise(frame.mask_normal(nb, &after)).ok_or(Error::new(ErrorKind::UndefinedNormal, c"a mask cell beside the obstacle"))?;
                 }
                 Ok(())
             })
@@ -211,7 +218,7 @@ impl Description {
     pub fn surface_entries(&self, shape: Shape) -> Result<u32, Error> {
         let l = self.plan()?;
         if !self.has_obstacles() {
-            return Err(Error::NotEnabled);
+            return Err(Error::new(ErrorKind::NotEnabled, NO_OBSTACLES));
         }
         let frame = Frame { n: l.n, boundary: self.boundary, dim: self.dim as usize };
         let none = |_: [usize; 3]| false;
@@ -253,7 +260,7 @@ impl World {
     /// the shape: `CellOccupied` if it covers a particle, and so on.
     pub fn surface_entries(&self, shape: Shape) -> Result<u32, Error> {
         if !self.head.desc.has_obstacles() {
-            return Err(Error::NotEnabled);
+            return Err(Error::new(ErrorKind::NotEnabled, NO_OBSTACLES));
         }
         Addition::of_shape(shape, &self.frame(), &mut |a| self.entries_added(a)).map(|n| n as u32)
     }
@@ -294,15 +301,15 @@ impl World {
     fn add_obstacles(&mut self, a: &Addition<'_>, e: f32, from_mask: bool) -> Result<(), Error> {
         // `has_obstacles`: a build without obstacles keeps none of this.
         if !self.head.desc.has_obstacles() {
-            return Err(Error::NotEnabled);
+            return Err(Error::new(ErrorKind::NotEnabled, NO_OBSTACLES));
         }
-        restitution(e)?;
+        restitution(e, E)?;
         let (l, frame) = (*self.layout(), self.frame());
         let site = |c: [usize; 3]| l.site(c[0], c[1], c[2]);
         let new_entries = self.entries_added(a)?;
         let capacity = l.surface().len / core::mem::size_of::<Surface>();
         if self.head.surfaces as usize + new_entries > capacity {
-            return Err(Error::SurfaceTableFull);
+            return Err(Error::new(ErrorKind::SurfaceTableFull, c"desc.surface_capacity"));
         }
 
         // Pass 2: the bits, then the entries, read off the plane as it now is.
@@ -359,9 +366,9 @@ impl World {
     /// here) and restitution.
     pub fn add_obstacle(&mut self, pos: [u32; 3], normal: [f32; 3], e: f32) -> Result<(), Error> {
         self.locate(pos)?;
-        finite(&normal)?;
+        finite(&normal, c"normal")?;
         let nrm = in_plane(normal, self.dim());
-        normalise(nrm).ok_or(Error::UndefinedNormal)?;
+        normalise(nrm).ok_or(Error::new(ErrorKind::UndefinedNormal, c"normal"))?;
         let c = pos.map(|v| v as usize);
         let a = Addition { lo: c, hi: c.map(|v| v + 1), inside: &|q| q == c, normal: &|_, _, _| nrm };
         self.add_obstacles(&a, e, false)
@@ -382,7 +389,7 @@ impl World {
     pub fn add_obstacle_mask(&mut self, mask: &[u8], e: f32) -> Result<(), Error> {
         let l = *self.layout();
         if mask.len() != l.cells {
-            return Err(Error::BadLength);
+            return Err(Error::new(ErrorKind::BadLength, c"mask"));
         }
         let inside = |c: [usize; 3]| mask[l.site(c[0], c[1], c[2]).cell] != 0;
         let normal = |f: &Frame, c, obstacle: Mask<'_>| f.mask_normal(c, obstacle);

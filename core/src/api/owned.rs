@@ -8,7 +8,7 @@ use core::alloc::Layout;
 use core::ops::{Deref, DerefMut};
 use core::ptr::NonNull;
 
-use crate::{world_bytes, Description, Error, World, WORLD_ALIGN};
+use crate::{world_bytes, Description, Error, ErrorKind, World, WORLD_ALIGN};
 
 /// A world in memory the library allocated and frees on drop.
 pub struct WorldBox {
@@ -27,9 +27,9 @@ impl WorldBox {
         // The allocation is aligned, so the alignment slack of world_bytes
         // is not needed; it is kept so that the size is the one reported.
         let size = world_bytes(desc)?;
-        let layout = Layout::from_size_align(size, WORLD_ALIGN).map_err(|_| Error::TooLarge)?;
+        let layout = Layout::from_size_align(size, WORLD_ALIGN).map_err(|_| Error::new(ErrorKind::TooLarge, crate::storage::layout::TOTAL))?;
         // SAFETY: size > 0 (the header alone is larger).
-        let ptr = NonNull::new(unsafe { alloc_zeroed(layout) }).ok_or(Error::OutOfMemory)?;
+        let ptr = NonNull::new(unsafe { alloc_zeroed(layout) }).ok_or(Error::new(ErrorKind::OutOfMemory, c"the world's memory"))?;
         // SAFETY: the allocation is `size` bytes, ours until freed below.
         let memory = unsafe { core::slice::from_raw_parts_mut(ptr.as_ptr(), size) };
         match World::init(desc, memory) {
@@ -64,9 +64,9 @@ impl WorldBox {
         // SAFETY: forwarded to the caller.
         let world = unsafe { World::from_ptr(ptr)? };
         if !world.is_owned() {
-            return Err(Error::NotOwned);
+            return Err(Error::new(ErrorKind::NotOwned, c"world"));
         }
-        let base = NonNull::new(ptr).ok_or(Error::NotAWorld)?;
+        let base = NonNull::new(ptr).ok_or(Error::new(ErrorKind::NotAWorld, c"world"))?;
         Ok(WorldBox { base, world: NonNull::from(world) })
     }
 }
@@ -120,6 +120,6 @@ mod tests {
         let w = World::init(&desc, bytes).unwrap();
         let p = w.as_ptr();
         // SAFETY: p points at a live world in `memory`.
-        assert_eq!(unsafe { WorldBox::from_raw(p) }.err(), Some(Error::NotOwned));
+        assert_eq!(unsafe { WorldBox::from_raw(p) }.err().map(|e| e.kind()), Some(ErrorKind::NotOwned));
     }
 }

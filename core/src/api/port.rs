@@ -11,7 +11,7 @@
 //! world.
 
 use crate::api::desc::Drift;
-use crate::api::error::Error;
+use crate::api::error::{Error, ErrorKind};
 use crate::rules::emitter::{split_rate, EmitterStats};
 use crate::rules::fixed::{csqrt, divr, magnitude, parts, scaled, scaled_by, to_fine, unit_scale};
 use crate::rules::force::Swirl;
@@ -344,12 +344,22 @@ impl World {
         let PortPlanes { occupancy, velocity, life, mass_index, id, age, tag, .. } = *planes;
         let own = self.port_planes();
         let lengths = [(occupancy.len() * 8, own.occupancy.len() * 8), (velocity.len(), own.velocity.len()), (life.len(), own.life.len()), (mass_index.len(), own.mass_index.len()), (id.len(), own.id.len()), (age.len(), own.age.len()), (tag.len(), own.tag.len()), (emitters.len(), self.slots().len())];
-        if lengths.iter().any(|(a, b)| a != b) {
-            return Err(Error::BadLength);
+        if let Some(i) = lengths.iter().position(|(a, b)| a != b) {
+            let part = match i {
+                0 => c"planes.occupancy is not the world's length",
+                1 => c"planes.velocity is not the world's length",
+                2 => c"planes.life is not the world's length",
+                3 => c"planes.mass_index is not the world's length",
+                4 => c"planes.id is not the world's length",
+                5 => c"planes.age is not the world's length",
+                6 => c"planes.tag is not the world's length",
+                _ => c"emitters: not one entry an emitter",
+            };
+            return Err(Error::new(ErrorKind::BadLength, part));
         }
         // The last id given only grows (M6b).
         if c.ids_given < self.head.ids_given {
-            return Err(Error::ImageInvalid);
+            return Err(Error::new(ErrorKind::ImageInvalid, c"counts.ids_given is below the world's"));
         }
         let classes = self.head.masses as usize;
         let obstacle: &[u64] = self.plane(l.obstacle());
@@ -362,8 +372,11 @@ impl World {
         let dim = self.dim();
         let mut count = 0u64;
         for (i, &word) in occupancy.iter().enumerate() {
-            if i % l.row_words == l.row_words - 1 && word & padding != 0 || obstacle.get(i).is_some_and(|o| o & word != 0) {
-                return Err(Error::ImageInvalid);
+            if i % l.row_words == l.row_words - 1 && word & padding != 0 {
+                return Err(Error::new(ErrorKind::ImageInvalid, c"planes.occupancy has a bit past a row's end"));
+            }
+            if obstacle.get(i).is_some_and(|o| o & word != 0) {
+                return Err(Error::new(ErrorKind::ImageInvalid, c"planes.occupancy has a particle on an obstacle"));
             }
             count += u64::from(word.count_ones());
             let mut bits = word;
@@ -372,22 +385,22 @@ impl World {
                 bits &= bits - 1;
                 let cell = (i / l.row_words) * l.n[0] + x;
                 if mass_index.get(cell).is_some_and(|&m| usize::from(m) >= classes) {
-                    return Err(Error::ImageInvalid);
+                    return Err(Error::new(ErrorKind::ImageInvalid, c"planes.mass_index names a class the world has not"));
                 }
                 if id.len() >= 4 * (cell + 1) && !(1..=c.ids_given).contains(&u32::from_ne_bytes([id[4 * cell], id[4 * cell + 1], id[4 * cell + 2], id[4 * cell + 3]])) {
-                    return Err(Error::ImageInvalid);
+                    return Err(Error::new(ErrorKind::ImageInvalid, c"planes.id holds an id never given"));
                 }
                 for k in 0..dim {
                     let at = cell * dim + k;
                     let q = stored(velocity, at, if wide { 2 } else { 1 });
                     if q.abs() > limit {
-                        return Err(Error::ImageInvalid);
+                        return Err(Error::new(ErrorKind::ImageInvalid, c"planes.velocity holds a component out of range"));
                     }
                 }
             }
         }
         if Some(count) != self.head.counters.particles.checked_add(c.emitted).and_then(|n| n.checked_sub(c.exited)).and_then(|n| n.checked_sub(c.expired)) {
-            return Err(Error::ImageInvalid);
+            return Err(Error::new(ErrorKind::ImageInvalid, c"planes.occupancy does not hold the particles counts says"));
         }
         let (head, p) = self.planes::<u8>();
         head.ids_given = c.ids_given;

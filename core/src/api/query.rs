@@ -1,7 +1,7 @@
 //! What a world can be asked: a cell, every particle, densities for a
 //! texture, statistics (M10), and the particles and motion inside a box.
 
-use crate::Error;
+use crate::{Error, ErrorKind};
 use crate::rules::quant::{with_quant, Quant};
 use crate::storage::layout::Layout;
 use crate::storage::world::{World, ENERGY_SCALE};
@@ -198,11 +198,11 @@ impl World {
             r[k] = res[k] as usize;
             let used = k < self.dim();
             if r[k] == 0 || r[k] > l.n[k] || (!used && r[k] != 1) {
-                return Err(Error::BadResolution);
+                return Err(Error::new(ErrorKind::BadResolution, c"res"));
             }
         }
         if r[0].checked_mul(r[1]).and_then(|v| v.checked_mul(r[2])) != Some(len) {
-            return Err(Error::BadResolution);
+            return Err(Error::new(ErrorKind::BadResolution, c"out"));
         }
         let occ: &[u64] = self.plane(l.occupancy());
         // In u64: i * n can overflow a 32-bit usize; the result is <= n.
@@ -268,10 +268,10 @@ impl World {
         let (mut lo, mut hi) = ([0usize; 3], [1usize; 3]);
         for k in 0..self.dim() {
             if min[k] >= max[k] {
-                return Err(Error::BadShape);
+                return Err(Error::new(ErrorKind::BadShape, c"min is not below max"));
             }
             if max[k] as usize > l.n[k] {
-                return Err(Error::OutOfBounds);
+                return Err(Error::new(ErrorKind::OutOfBounds, c"max"));
             }
             (lo[k], hi[k]) = (min[k] as usize, max[k] as usize);
         }

@@ -34,12 +34,14 @@
 //!
 //! // A damaged image is refused.
 //! image[100] ^= 4;
-//! assert_eq!(world.load(&image), Err(mpca::Error::ImageChecksum));
+//! assert_eq!(world.load(&image).unwrap_err().kind(), mpca::ErrorKind::ImageChecksum);
 //! ```
 
 use core::mem::size_of;
 
-use crate::Error;
+use core::ffi::CStr;
+
+use crate::{Error, ErrorKind};
 use crate::api::desc::{Boundary, Collisions, Description, Drag, Drift, Forces, Identity, Quantization, Vortex};
 use crate::api::edit::storable;
 use crate::rules::assign::Method;
@@ -157,7 +159,7 @@ struct Get<'a> {
 impl<'a> Get<'a> {
     fn take(&mut self, n: usize) -> Result<&'a [u8], Error> {
         if n > self.rest.len() {
-            return Err(Error::ImageInvalid);
+            return Err(invalid(c"a part past the end"));
         }
         let (head, rest) = self.rest.split_at(n);
         self.rest = rest;
@@ -175,7 +177,7 @@ impl<'a> Get<'a> {
         match self.u8()? {
             0 => Ok(false),
             1 => Ok(true),
-            _ => Err(Error::ImageInvalid),
+            _ => Err(invalid(c"desc (a flag)")),
         }
     }
     fn u32(&mut self) -> Result<u32, Error> {
@@ -189,7 +191,7 @@ impl<'a> Get<'a> {
     }
     /// `n` reserved bytes, which must be zero.
     fn zeros(&mut self, n: usize) -> Result<(), Error> {
-        if self.take(n)?.iter().all(|&b| b == 0) { Ok(()) } else { Err(Error::ImageInvalid) }
+        if self.take(n)?.iter().all(|&b| b == 0) { Ok(()) } else { Err(invalid(RESERVED)) }
     }
 }
 
@@ -349,7 +351,7 @@ fn put_desc(p: &mut Put<'_>, d: &Description) {
 }
 
 fn get_desc(g: &mut Get<'_>) -> Result<Description, Error> {
-    let bad = Error::ImageInvalid;
+    let bad = invalid(c"desc (a value)");
     let dim = g.u32()?;
     let size = [g.u32()?, g.u32()?, g.u32()?];
     let seed = g.u64()?;
@@ -526,31 +528,33 @@ struct Image<'a> {
 fn read(image: &[u8]) -> Result<Image<'_>, Error> {
     let m = image.len().min(MAGIC.len());
     if image[..m] != MAGIC[..m] {
-        return Err(Error::NotAnImage);
+        return Err(Error::new(ErrorKind::NotAnImage, c"header: magic"));
     }
     if image.len() < HEAD {
-        return Err(Error::ImageLength);
+        return Err(Error::new(ErrorKind::ImageLength, c"header"));
     }
     let mut g = Get { rest: &image[MAGIC.len()..] };
     let version = g.u32()?;
     let emitter_len = match version {
         1 => EMITTER_V1,
         2 | 3 => EMITTER,
-        _ => return Err(Error::ImageVersion),
+        _ => return Err(Error::new(ErrorKind::ImageVersion, c"header: version")),
     };
     let reserved = g.u32()?;
     if g.u64()? != image.len() as u64 {
-        return Err(Error::ImageLength);
+        return Err(Error::new(ErrorKind::ImageLength, c"header: length"));
     }
     let (body, sum) = image.split_at(image.len() - CHECKSUM);
     if crc32(body) != le_u32(sum, 0) {
-        return Err(Error::ImageChecksum);
+        return Err(Error::new(ErrorKind::ImageChecksum, c"checksum"));
     }
     // From here on the bytes are what the writer wrote; a refusal means the
     // writer was not this library (or a build with other parts).
-    let bad = Error::ImageInvalid;
-    if reserved != 0 || image.len() < FIXED + CHECKSUM {
-        return Err(bad);
+    if reserved != 0 {
+        return Err(invalid(RESERVED));
+    }
+    if image.len() < FIXED + CHECKSUM {
+        return Err(invalid(c"length"));
     }
     let mut desc = get_desc(&mut g)?;
     // M13: version 3 is a world with bodies, and only such a world.
@@ -559,22 +563,23 @@ fn read(image: &[u8]) -> Result<Image<'_>, Error> {
         (desc.body_capacity, desc.body_surface_capacity, crushed, redraws) = (g.u32()?, g.u32()?, g.u64()?, g.u32()?);
         g.zeros(4)?;
         if !desc.obstacles || desc.body_capacity == 0 {
-            return Err(bad);
+            return Err(invalid(c"version 3 without bodies"));
         }
     }
-    let layout = desc.plan().map_err(|e| match e {
-        Error::Dim3Disabled | Error::Q16Disabled | Error::FeatureDisabled | Error::TooLarge => e,
-        _ => bad,
+    // A description the world would refuse: the field at fault named.
+    let layout = desc.plan().map_err(|e| match e.kind() {
+        ErrorKind::Dim3Disabled | ErrorKind::Q16Disabled | ErrorKind::FeatureDisabled | ErrorKind::TooLarge => e,
+        _ => invalid(e.c_detail()),
     })?;
     // A 2D world keeps 1 as its third size (World::init).
     if desc.dim == 2 && desc.size[2] != 1 {
-        return Err(bad);
+        return Err(invalid(c"desc.size[2]"));
     }
     let step = g.u64()?;
     let [particles, emitted, exited, expired, shortfall, collisions, clamps] =
         [g.u64()?, g.u64()?, g.u64()?, g.u64()?, g.u64()?, g.u64()?, g.u64()?];
     // 16 bytes in the image; the world counts in a u64.
-    let clamp_energy = u64::try_from(u128::from_le_bytes(g.array()?)).map_err(|_| Error::ImageInvalid)?;
+    let clamp_energy = u64::try_from(u128::from_le_bytes(g.array()?)).map_err(|_| invalid(c"clamp energy"))?;
     let [displaced, processed, skipped] = [g.u64()?, g.u64()?, g.u64()?];
     let counters =
         Counters { particles, emitted, exited, expired, shortfall, collisions, clamps, clamp_energy, displaced, processed, skipped };
@@ -582,18 +587,23 @@ fn read(image: &[u8]) -> Result<Image<'_>, Error> {
     // What was a reserved zero word: a world without ids gives none.
     let ids_given = g.u32()?;
     if !desc.identity.ids() && ids_given != 0 {
-        return Err(bad);
+        return Err(invalid(c"ids given"));
     }
     let mass_room = if desc.per_particle_mass { 1..=desc.mass_classes as usize } else { 0..=0 };
-    if !mass_room.contains(&masses)
-        || surfaces > layout.surface().len / size_of::<Surface>()
-        || emitters > layout.emitters().len / size_of::<Slot>()
-        || particles > layout.cells as u64
-    {
-        return Err(bad);
+    if !mass_room.contains(&masses) {
+        return Err(invalid(c"mass count"));
+    }
+    if surfaces > layout.surface().len / size_of::<Surface>() {
+        return Err(invalid(c"surface count"));
+    }
+    if emitters > layout.emitters().len / size_of::<Slot>() {
+        return Err(invalid(c"emitter count"));
+    }
+    if particles > layout.cells as u64 {
+        return Err(invalid(c"particle count"));
     }
     if image_len(&desc, &layout, particles as usize, masses, surfaces, (emitters, emitter_len)) != Some(image.len()) {
-        return Err(bad);
+        return Err(invalid(c"length"));
     }
     let (width, _) = width_and_scale(desc.quantization);
     let n = particles as usize;
@@ -632,7 +642,7 @@ fn read(image: &[u8]) -> Result<Image<'_>, Error> {
 
 /// The rules a live world keeps, held against an image's content.
 fn check(img: &Image<'_>) -> Result<(), Error> {
-    let bad = Err(Error::ImageInvalid);
+    let bad = |detail| Err(invalid(detail));
     let (d, l) = (&img.desc, &img.layout);
     let dim = d.dim as usize;
 
@@ -643,13 +653,16 @@ fn check(img: &Image<'_>) -> Result<(), Error> {
     for i in 0..l.occupancy().len / 8 {
         let occ = le_u64(img.occupancy, i);
         let obs = if d.obstacles { le_u64(img.obstacle, i) } else { 0 };
-        if (i % l.row_words == l.row_words - 1 && (occ | obs) & tail != 0) || occ & obs != 0 {
-            return bad;
+        if i % l.row_words == l.row_words - 1 && (occ | obs) & tail != 0 {
+            return bad(c"occupancy: a bit past a row");
+        }
+        if occ & obs != 0 {
+            return bad(c"occupancy: a particle on an obstacle");
         }
         count += u64::from(occ.count_ones());
     }
     if count != img.counters.particles {
-        return bad;
+        return bad(c"particle count");
     }
 
     // Velocities the step could have stored (M1), mass classes in use.
@@ -660,17 +673,17 @@ fn check(img: &Image<'_>) -> Result<(), Error> {
             q[k] = component(&v[k * width..], width);
         }
         if q.iter().any(|c| c.abs() > scale) || !storable(q, scale) {
-            return bad;
+            return bad(c"velocities");
         }
     }
     if img.mass_index.iter().any(|&i| usize::from(i) >= img.masses) {
-        return bad;
+        return bad(c"mass classes");
     }
     // Ids that were given (M6b): from 1 to the count given. (That no two
     // are equal is not checked: it would take memory or time a load does
     // not have.)
     if (0..img.id.len() / 4).any(|i| !(1..=img.ids_given).contains(&le_u32(img.id, i))) {
-        return bad;
+        return bad(c"ids");
     }
 
     // Force and wind planes: finite, as the set functions require, and no
@@ -678,25 +691,26 @@ fn check(img: &Image<'_>) -> Result<(), Error> {
     let float = |plane: &[u8], i: usize| f32::from_bits(le_u32(plane, i));
     let floats = |plane: &[u8]| (0..plane.len() / 4).all(|i| float(plane, i).is_finite());
     if !floats(img.field) || !floats(img.potential) || !floats(img.wind) {
-        return bad;
+        return bad(c"force, potential or wind planes");
     }
     let wind_cell = |i: usize| -> [f32; 3] { core::array::from_fn(|k| if k < dim { float(img.wind, i + k) } else { 0.0 }) };
     // Cell by cell, `dim` values each.
     for c in 0..img.wind.len() / 4 / dim {
         if !crate::api::speed::slow(&wind_cell(c * dim)[..dim]) {
-            return bad;
+            return bad(c"wind plane");
         }
     }
 
     // The mass table: distinct valid masses, class 0 the description's.
     let table = |i: usize| f32::from_bits(le_u32(img.mass_table, i));
     for i in 0..img.masses {
-        if crate::api::checks::mass(table(i)).is_err() || (0..i).any(|j| table(j).to_bits() == table(i).to_bits()) {
-            return bad;
+        let detail = c"mass table";
+        if crate::api::checks::mass(table(i), detail).is_err() || (0..i).any(|j| table(j).to_bits() == table(i).to_bits()) {
+            return bad(detail);
         }
     }
     if img.masses > 0 && table(0).to_bits() != d.mass.to_bits() {
-        return bad;
+        return bad(c"mass table");
     }
 
     // The surface table: obstacle cells in increasing order, unit normals
@@ -706,21 +720,22 @@ fn check(img: &Image<'_>) -> Result<(), Error> {
         let s = get_surface(b);
         let cell = s.cell as usize;
         if cell >= l.cells || last.is_some_and(|c| c >= s.cell) {
-            return bad;
+            return bad(c"surface table");
         }
         last = Some(s.cell);
         let (row, x) = (cell / l.n[0], cell % l.n[0]);
         let bit = row * l.row_words * 64 + x;
         if le_u64(img.obstacle, bit / 64) >> (bit % 64) & 1 == 0 {
-            return bad;
+            return bad(c"surface table");
         }
         // normalise() leaves |N|^2 within a few 1e-7 of 1; NaN is not unit.
         let unit = (crate::rules::vector::dot(s.normal, s.normal) - 1.0).abs() <= 1e-4;
         if !unit || (dim == 2 && s.normal[2] != 0.0) {
-            return bad;
+            return bad(c"surface table");
         }
-        if crate::api::checks::restitution(s.restitution).is_err() || s.from_mask > 1 {
-            return bad;
+        let detail = c"surface table";
+        if crate::api::checks::restitution(s.restitution, detail).is_err() || s.from_mask > 1 {
+            return bad(detail);
         }
     }
 
@@ -733,21 +748,23 @@ fn check(img: &Image<'_>) -> Result<(), Error> {
         let e = s.emitter;
         // Nothing is placed that was not asked for.
         if s.stats.delivered > s.stats.requested {
-            return bad;
+            return bad(c"emitter counts");
         }
         let mut stored = e;
-        if checked(&mut stored, dim, l.n, d.lifetimes).is_err() || stored != e {
-            return bad;
+        // What add_emitter would refuse, named.
+        checked(&mut stored, dim, l.n, d.lifetimes).map_err(|e| invalid(e.c_detail()))?;
+        if stored != e {
+            return bad(c"emitter table");
         }
         // The word of the mass class and the tag: two zero bytes above, and
         // no tag where the world has none.
         if s.class >> 16 != 0 || (s.tag() != 0 && !d.identity.tags()) {
-            return bad;
+            return bad(c"emitter table");
         }
         let class = usize::from(s.mass_index());
         let known = if d.per_particle_mass { class < img.masses && table(class).to_bits() == e.mass.to_bits() } else { class == 0 && e.mass.to_bits() == d.mass.to_bits() };
         if !known {
-            return bad;
+            return bad(c"emitter table");
         }
     }
     Ok(())
@@ -758,7 +775,7 @@ fn check(img: &Image<'_>) -> Result<(), Error> {
 /// the body surface table for the bodies' entries.
 #[cfg(feature = "obstacles")]
 fn check_bodies(img: &Image<'_>) -> Result<(), Error> {
-    let bad = Err(Error::ImageInvalid);
+    let bad = |detail| Err(invalid(detail));
     let (d, l) = (&img.desc, &img.layout);
     let dim = d.dim as usize;
     let slots = img.body.len() / BODY;
@@ -766,18 +783,19 @@ fn check_bodies(img: &Image<'_>) -> Result<(), Error> {
         let body = get_body(b);
         let Some(shape) = body.shape() else {
             if b.iter().any(|&x| x != 0) {
-                return bad;
+                return bad(c"body table");
             }
             continue;
         };
         // As the library stores a body it accepts: the same bits.
-        let Ok(stored) = crate::rules::body::Body::new(shape, body.velocity, body.restitution, dim) else { return bad };
+        // What add_body would refuse, named.
+        let stored = crate::rules::body::Body::new(shape, body.velocity, body.restitution, dim).map_err(|e| invalid(e.c_detail()))?;
         let same = |x: &[f32], y: &[f32]| x.iter().zip(y).all(|(a, b)| a.to_bits() == b.to_bits());
         let fields = |b: &crate::rules::body::Body| [b.a, b.b, b.velocity, [b.radius, b.restitution, 0.0]];
         // The reserved words: after the velocity and after each tally.
         let reserved = [12, 22, 32].iter().any(|&w| le_u32(b, w) != 0);
         if stored.kind != body.kind || !fields(&stored).iter().zip(&fields(&body)).all(|(x, y)| same(x, y)) || reserved {
-            return bad;
+            return bad(c"body table");
         }
     }
     let obstacle = |c: [usize; 3]| {
@@ -789,8 +807,11 @@ fn check_bodies(img: &Image<'_>) -> Result<(), Error> {
     let draw = crate::api::bodies::Draw { frame, count: slots, body: &body, is_static: &obstacle };
     let mut inside = false;
     each_bit(l, |k| le_u64(img.occupancy, k), |row, x| inside |= draw.owner([x, row % l.n[1], row / l.n[1]]).is_some());
-    if inside || draw.entries() > d.body_surface_capacity as usize {
-        return bad;
+    if inside {
+        return bad(c"occupancy: a particle in a body");
+    }
+    if draw.entries() > d.body_surface_capacity as usize {
+        return bad(c"desc.body_surface_capacity");
     }
     Ok(())
 }
@@ -940,6 +961,50 @@ fn ones(words: &[u64]) -> usize {
 
 
 
+/// An `ImageInvalid` naming the part of the image at fault.
+fn invalid(detail: &'static CStr) -> Error {
+    Error::new(ErrorKind::ImageInvalid, detail)
+}
+
+/// The detail of reserved bytes that are not zero.
+const RESERVED: &CStr = c"reserved bytes";
+
+/// The part of the plan of memory in which an image's description `image`
+/// and a world's `world` differ, for [`World::load`]'s refusal: the sizes,
+/// the velocity width, a plane one has and the other not, or a capacity.
+#[cold]
+#[inline(never)]
+fn mismatch(image: &Description, world: &Description) -> &'static CStr {
+    let (a, b) = (image, world);
+    if a.dim != b.dim || a.size != b.size {
+        c"desc.size"
+    } else if a.quantization != b.quantization {
+        c"desc.quantization"
+    } else if a.obstacles != b.obstacles {
+        c"desc.obstacles"
+    } else if a.per_particle_mass != b.per_particle_mass {
+        c"desc.per_particle_mass"
+    } else if a.lifetimes != b.lifetimes {
+        c"desc.lifetimes"
+    } else if a.forces.field != b.forces.field || a.forces.potential != b.forces.potential {
+        c"desc.forces"
+    } else if a.drag.field != b.drag.field {
+        c"desc.drag.field"
+    } else if a.identity != b.identity {
+        c"desc.identity"
+    } else if a.mass_classes != b.mass_classes {
+        c"desc.mass_classes"
+    } else if a.surface_capacity != b.surface_capacity {
+        c"desc.surface_capacity"
+    } else if a.emitter_capacity != b.emitter_capacity {
+        c"desc.emitter_capacity"
+    } else if a.body_capacity != b.body_capacity {
+        c"desc.body_capacity"
+    } else {
+        c"desc.body_surface_capacity"
+    }
+}
+
 /// The description of the world `image` holds, after checking the whole
 /// image as [`World::load`] does. [`crate::world_bytes`] of it is the memory
 /// [`World::init_from_image`] needs.
@@ -963,7 +1028,7 @@ impl World {
     /// refused with `OutputTooSmall`, and nothing is written.
     pub fn save(&self, out: &mut [u8]) -> Result<usize, Error> {
         let len = self.snapshot_bytes();
-        let out = out.get_mut(..len).ok_or(Error::OutputTooSmall)?;
+        let out = out.get_mut(..len).ok_or(Error::new(ErrorKind::OutputTooSmall, c"out"))?;
         let h = &self.head;
         let l = h.layout;
         let dim = self.dim();
@@ -1081,7 +1146,7 @@ impl World {
     pub fn load(&mut self, image: &[u8]) -> Result<(), Error> {
         let img = read(image)?;
         if img.layout != self.head.layout {
-            return Err(Error::ImageMismatch);
+            return Err(Error::computed(ErrorKind::ImageMismatch, || mismatch(&img.desc, &self.head.desc)));
         }
         apply(self, &img);
         Ok(())

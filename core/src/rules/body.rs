@@ -2,7 +2,8 @@
 //! of each, and the two rules that read a body's velocity: the push-out of
 //! a particle a body takes, and eq. 9 in the frame of a moving surface.
 
-use crate::Error;
+use crate::{Error, ErrorKind};
+use crate::api::obstacles::E;
 use crate::api::checks::{finite, restitution};
 use crate::rules::obstacle::{dot_q30, Shape};
 use crate::rules::fixed::sat;
@@ -114,7 +115,7 @@ impl Body {
     pub(crate) fn new(shape: Shape, u: [f32; 3], e: f32, dim: usize) -> Result<Body, Error> {
         let mut body = Body { restitution: e, ..Body::ZERO };
         body.set(shape, u, dim)?;
-        restitution(e)?;
+        restitution(e, E)?;
         Ok(body)
     }
 
@@ -123,7 +124,7 @@ impl Body {
     #[inline(never)]
     pub(crate) fn set(&mut self, shape: Shape, u: [f32; 3], dim: usize) -> Result<(), Error> {
         shape.check(dim)?;
-        finite(&u)?;
+        finite(&u, c"velocity")?;
         let mut u = u;
         if dim == 2 {
             u[2] = 0.0;
@@ -131,7 +132,7 @@ impl Body {
         // Decided exactly, as for a particle's velocity: a speed of 1 is
         // taken, whatever the rounding of a sum of squares would say.
         if !crate::api::speed::slow(&u[..dim]) {
-            return Err(Error::SpeedRange);
+            return Err(Error::new(ErrorKind::SpeedRange, c"velocity"));
         }
         // Kind 0 is a free slot: a shape's kind is stored one up.
         let (kind, a, b, radius) = shape.in_dim(dim).parts();

@@ -6,7 +6,9 @@
 //! counted as shortfall. Draws come from the emitter's own stream
 //! `(seed, step, emitter index)` (M8).
 
-use crate::Error;
+use core::ffi::CStr;
+
+use crate::{Error, ErrorKind};
 use crate::api::checks::{finite, negative};
 use crate::rules::fixed::{clamp_to, mulq, parts, sq, to_fine, unit_scale};
 use crate::rules::rng::Stream;
@@ -81,25 +83,41 @@ impl Slot {
 /// a `memcpy` call on a small core): callers check a copy of their own.
 pub(crate) fn checked(e: &mut Emitter, dim: usize, n: [usize; 3], lifetimes: bool) -> Result<(), Error> {
     // Every float is checked as given, before 2D drops the third axis.
-    finite(&[e.rate, e.velocity[0], e.velocity[1], e.velocity[2], e.spread])?;
+    finite(&[e.rate, e.velocity[0], e.velocity[1], e.velocity[2], e.spread], c"emitter.rate, velocity or spread")?;
     if dim == 2 {
         e.min[2] = 0;
         e.max[2] = 1;
         e.velocity[2] = 0.0;
     }
     if negative(e.rate) || negative(e.spread) || (0..3).any(|k| e.min[k] >= e.max[k] || e.max[k] as usize > n[k]) {
-        return Err(Error::BadEmitter);
+        return Err(Error::computed(ErrorKind::BadEmitter, || bad_field(e)));
     }
     if crate::api::speed::too_fast(e.velocity, e.spread) {
-        return Err(Error::SpeedRange);
+        return Err(Error::new(ErrorKind::SpeedRange, c"emitter.velocity and spread"));
     }
     if e.lifetime > u32::from(u16::MAX) {
-        return Err(Error::LifetimeRange);
+        return Err(Error::new(ErrorKind::LifetimeRange, c"emitter.lifetime"));
     }
     if e.lifetime > 0 && !lifetimes {
-        return Err(Error::NotEnabled);
+        return Err(Error::new(ErrorKind::NotEnabled, c"emitter.lifetime (desc.lifetimes is off)"));
     }
     Ok(())
+}
+
+/// The field [`checked`] refuses with `BadEmitter`. Apart, and asked only
+/// once the one test failed, so the test stays one.
+#[cold]
+#[inline(never)]
+fn bad_field(e: &Emitter) -> &'static CStr {
+    if negative(e.rate) {
+        c"emitter.rate is negative"
+    } else if negative(e.spread) {
+        c"emitter.spread is negative"
+    } else if (0..3).any(|k| e.min[k] >= e.max[k]) {
+        c"emitter.min is not below max"
+    } else {
+        c"emitter.max is past the world"
+    }
 }
 
 /// M6: how many particles a step asks of an emitter of rate `rate` (not

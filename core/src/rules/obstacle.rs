@@ -9,7 +9,7 @@
 //! undefined is refused, and so is anything that does not fit: adding an
 //! obstacle either succeeds whole or changes nothing.
 
-use crate::Error;
+use crate::{Error, ErrorKind};
 use crate::api::checks::finite;
 use crate::rules::vector::{dot, normalise};
 use crate::rules::fixed::{mulq, sat, scaled, DIAGONAL_Q30};
@@ -167,44 +167,49 @@ impl Shape {
 
     /// Checks every float as given, then the shape as the world uses it.
     pub(crate) fn check(&self, dim: usize) -> Result<(), Error> {
+        use ErrorKind as K;
         match *self {
             Shape::HalfSpace { point, normal } => {
-                finite(&point)?;
-                finite(&normal)?;
-                normalise(in_plane(normal, dim)).ok_or(Error::BadShape)?;
+                let detail = c"shape";
+                finite(&point, detail)?;
+                finite(&normal, detail)?;
+                normalise(in_plane(normal, dim)).ok_or(Error::new(K::BadShape, c"shape: normal of length 0"))?;
             }
             Shape::Box { min, max } => {
-                finite(&min)?;
-                finite(&max)?;
+                let detail = c"shape";
+                finite(&min, detail)?;
+                finite(&max, detail)?;
                 if (0..dim).any(|k| min[k] > max[k]) {
-                    return Err(Error::BadShape);
+                    return Err(Error::new(K::BadShape, c"shape: box min above max"));
                 }
             }
             Shape::Disc { centre, radius } => {
-                finite(&[centre[0], centre[1], radius])?;
+                finite(&[centre[0], centre[1], radius], c"shape")?;
                 if dim != 2 {
-                    return Err(Error::BadDimension);
+                    return Err(Error::new(K::BadDimension, c"shape: a disc in 3D"));
                 }
                 if radius <= 0.0 {
-                    return Err(Error::BadShape);
+                    return Err(Error::new(K::BadShape, c"shape: radius"));
                 }
             }
             Shape::Sphere { centre, radius } => {
-                finite(&centre)?;
-                finite(&[radius])?;
+                let detail = c"shape";
+                finite(&centre, detail)?;
+                finite(&[radius], detail)?;
                 if dim != 3 {
-                    return Err(Error::BadDimension);
+                    return Err(Error::new(K::BadDimension, c"shape: a sphere in 2D"));
                 }
                 if radius <= 0.0 {
-                    return Err(Error::BadShape);
+                    return Err(Error::new(K::BadShape, c"shape: radius"));
                 }
             }
             Shape::Capsule { a, b, radius } => {
-                finite(&a)?;
-                finite(&b)?;
-                finite(&[radius])?;
+                let detail = c"shape";
+                finite(&a, detail)?;
+                finite(&b, detail)?;
+                finite(&[radius], detail)?;
                 if radius <= 0.0 {
-                    return Err(Error::BadShape);
+                    return Err(Error::new(K::BadShape, c"shape: radius"));
                 }
             }
         }

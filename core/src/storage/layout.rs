@@ -4,9 +4,10 @@
 //! ([`Planes`]), where a cell lives in them ([`Site`]), and the bit and
 //! summary helpers of the bit planes.
 
+use core::ffi::CStr;
 use core::mem::{align_of, size_of};
 
-use crate::Error;
+use crate::{Error, ErrorKind};
 use crate::api::desc::{Checked, Description, Quantization};
 use crate::rules::emitter::Slot;
 use crate::rules::obstacle::Surface;
@@ -240,34 +241,35 @@ impl Layout {
         let dim = d.dim as usize;
         let mut n = [1usize; 3];
         for k in 0..dim {
-            n[k] = usize::try_from(d.size[k]).map_err(|_| Error::TooLarge)?;
+            n[k] = usize::try_from(d.size[k]).map_err(|_| Error::new(ErrorKind::TooLarge, CELLS))?;
         }
 
         // Cell indices are stored as u32 (surface table), so the cell count
         // must fit one; every byte count below is checked against usize,
         // and any that overflows is the one error TooLarge.
-        let cells = mul(mul(n[0], n[1])?, n[2])?;
+        let cells = mul(mul(n[0], n[1], Extent::Cells)?, n[2], Extent::Cells)?;
         if u32::try_from(cells).is_err() {
-            return Err(Error::TooLarge);
+            return Err(Error::new(ErrorKind::TooLarge, CELLS));
         }
         let rows = n[1] * n[2];
         let row_words = row_words(n[0]);
         // Bit planes are indexed by bit, so their bit count must fit too
         // (and with it their byte count, an eighth of it).
-        let bit_plane = mul(mul(row_words, rows)?, 64)? / 8;
+        let bit_plane = mul(mul(row_words, rows, Extent::Cells)?, 64, Extent::Cells)? / 8;
         let q = match d.quantization {
             Quantization::Bits8 => 1,
             Quantization::Bits16 => 2,
         };
         // `bytes` a cell where `on`.
-        let per_cell = |bytes: usize, on: bool| mul(cells, bytes * usize::from(on));
+        let per_cell = |bytes: usize, on: bool| mul(cells, bytes * usize::from(on), Extent::Cells);
         let summary_words = row_words.div_ceil(64);
         // M13's planes: the cells bodies cover, the body table after its
         // head, the body surface table and a step's tally per entry.
         #[cfg(feature = "obstacles")]
         let body = if d.has_bodies() {
             let entries = d.body_surface_capacity as usize;
-            [bit_plane, mul(d.body_capacity as usize, size_of::<Body>())? + size_of::<BodiesHead>(), mul(entries, size_of::<BodySurface>())?, mul(entries, size_of::<Tally>())?]
+            let surfaces = Extent::BodySurfaces;
+            [bit_plane, mul(d.body_capacity as usize, size_of::<Body>(), Extent::Bodies)? + size_of::<BodiesHead>(), mul(entries, size_of::<BodySurface>(), surfaces)?, mul(entries, size_of::<Tally>(), surfaces)?]
         } else {
             [0; 4]
         };
@@ -287,8 +289,8 @@ impl Layout {
             per_cell(4, d.forces.potential)?,
             per_cell(dim * 4, d.drag.field)?,
             if d.per_particle_mass { mass_plane(d.mass_classes as usize) } else { 0 },
-            mul(d.surface_capacity as usize * usize::from(d.obstacles), size_of::<crate::rules::obstacle::Surface>())?,
-            mul(d.emitter_capacity as usize, size_of::<crate::rules::emitter::Slot>())?,
+            mul(d.surface_capacity as usize * usize::from(d.obstacles), size_of::<crate::rules::obstacle::Surface>(), Extent::Surfaces)?,
+            mul(d.emitter_capacity as usize, size_of::<crate::rules::emitter::Slot>(), Extent::Emitters)?,
             #[cfg(feature = "identity")]
             per_cell(4, d.identity.ids())?,
             #[cfg(feature = "identity")]
@@ -309,10 +311,10 @@ impl Layout {
         let mut at = 0usize;
         for p in &mut plane {
             p.off = at;
-            at = at.checked_add(p.len).and_then(|e| e.checked_add(7)).ok_or(Error::TooLarge)? & !7;
+            at = at.checked_add(p.len).and_then(|e| e.checked_add(7)).ok_or(Error::new(ErrorKind::TooLarge, TOTAL))? & !7;
             // Slices may not exceed isize::MAX bytes.
             if at > isize::MAX as usize / 2 {
-                return Err(Error::TooLarge);
+                return Err(Error::new(ErrorKind::TooLarge, TOTAL));
             }
         }
         Ok(Layout { n, cells, row_words, summary_words, plane, total: at })
@@ -357,12 +359,46 @@ pub(crate) fn masses_and_classes(plane: &mut [f32], n: usize) -> (&mut [f32], &m
     (&mut table[..n], view(bytes))
 }
 
-/// `a * b`, or `TooLarge` where it overflows. Out of line: one copy for
-/// every size [`Layout::of`] checks.
+/// `a * b`, or `TooLarge` naming what was sized where it overflows. Out
+/// of line: one copy for every size [`Layout::of`] checks.
 #[inline(never)]
-fn mul(a: usize, b: usize) -> Result<usize, Error> {
-    a.checked_mul(b).ok_or(Error::TooLarge)
+fn mul(a: usize, b: usize, what: Extent) -> Result<usize, Error> {
+    a.checked_mul(b).ok_or_else(|| Error::computed(ErrorKind::TooLarge, || what.field()))
 }
+
+/// What [`mul`] sizes, for its refusal's detail: a tag rather than the
+/// text, which a build without details then never references.
+#[derive(Clone, Copy)]
+enum Extent {
+    /// A plane of the cells: the sizes alone make it.
+    Cells,
+    Surfaces,
+    Emitters,
+    #[cfg(feature = "obstacles")]
+    Bodies,
+    #[cfg(feature = "obstacles")]
+    BodySurfaces,
+}
+
+impl Extent {
+    fn field(self) -> &'static CStr {
+        match self {
+            Extent::Cells => CELLS,
+            Extent::Surfaces => c"desc.surface_capacity",
+            Extent::Emitters => c"desc.emitter_capacity",
+            #[cfg(feature = "obstacles")]
+            Extent::Bodies => c"desc.body_capacity",
+            #[cfg(feature = "obstacles")]
+            Extent::BodySurfaces => c"desc.body_surface_capacity",
+        }
+    }
+}
+
+/// The detail of a cell count or plane too large: the sizes alone make it.
+const CELLS: &CStr = c"desc.size";
+
+/// The detail of a world too large as a whole.
+pub(crate) const TOTAL: &CStr = c"desc.size and the capacities";
 
 /// Mutable views of every plane, borrowed together.
 pub(crate) struct Planes<'a, Q> {

@@ -8,10 +8,10 @@
 
 use core::mem::{align_of, size_of};
 
-use crate::Error;
+use crate::{Error, ErrorKind};
 use crate::api::desc::Description;
 use crate::rules::emitter::Slot;
-use crate::storage::layout::{test_bit, view, view_counted, view_counted_ref, view_ref, Layout, Planes, Site};
+use crate::storage::layout::{test_bit, view, view_counted, view_counted_ref, view_ref, Layout, Planes, Site, TOTAL};
 use crate::storage::plain::Plain;
 
 /// Counters the step keeps. All integers (clamped energy in 2^-32 units),
@@ -114,7 +114,7 @@ pub struct World {
 /// Bytes a world built from `desc` needs, alignment slack included.
 pub fn world_bytes(desc: &Description) -> Result<usize, Error> {
     let layout = desc.plan()?;
-    (align_of::<Header>() - 1 + size_of::<Header>()).checked_add(layout.total).ok_or(Error::TooLarge)
+    (align_of::<Header>() - 1 + size_of::<Header>()).checked_add(layout.total).ok_or(Error::new(ErrorKind::TooLarge, TOTAL))
 }
 
 /// The alignment a world's memory is rounded up to inside the buffer.
@@ -131,9 +131,9 @@ impl World {
         let layout = desc.plan();
         let layout = layout.as_ref().map_err(|&e| e)?;
         let pad = (memory.as_ptr() as usize).wrapping_neg() & (WORLD_ALIGN - 1);
-        let need = pad.checked_add(size_of::<Header>()).and_then(|n| n.checked_add(layout.total)).ok_or(Error::TooLarge)?;
+        let need = pad.checked_add(size_of::<Header>()).and_then(|n| n.checked_add(layout.total)).ok_or(Error::new(ErrorKind::TooLarge, TOTAL))?;
         if memory.len() < need {
-            return Err(Error::BufferTooSmall);
+            return Err(Error::new(ErrorKind::BufferTooSmall, c"memory"));
         }
         let region = &mut memory[pad..need];
         // Cleared as 64-bit words, which it is made of: `pad` aligns its
@@ -192,7 +192,7 @@ impl World {
     /// then does through the pointer is its own to justify.
     pub unsafe fn from_ptr_raw(ptr: *mut u8) -> Result<*mut World, Error> {
         if ptr.is_null() || (ptr as usize) % WORLD_ALIGN != 0 {
-            return Err(Error::NotAWorld);
+            return Err(Error::new(ErrorKind::NotAWorld, c"world"));
         }
         // SAFETY: the caller promises a readable, aligned header's worth.
         let (tag, len) = unsafe {
@@ -200,7 +200,7 @@ impl World {
             (core::ptr::addr_of!((*h).tag).read(), core::ptr::addr_of!((*h).len).read())
         };
         if tag != TAG ^ ptr as u64 {
-            return Err(Error::NotAWorld);
+            return Err(Error::new(ErrorKind::NotAWorld, c"world"));
         }
         // The tag says a world was built here with `len` plane bytes.
         Ok(core::ptr::slice_from_raw_parts_mut(ptr, len) as *mut World)
@@ -357,7 +357,7 @@ impl World {
         for k in 0..3 {
             let v = pos[k] as usize;
             if v >= l.n[k] {
-                return Err(Error::OutOfBounds);
+                return Err(Error::new(ErrorKind::OutOfBounds, c"pos"));
             }
             c[k] = v;
         }
