@@ -199,14 +199,6 @@ impl World {
         self.bodies().map_or(&[][..], |(_, t)| t)
     }
 
-    /// Word `i` of the body cell plane, 0 without bodies.
-    pub(crate) fn body_word_of(&self, i: usize) -> u64 {
-        if self.bodies().is_err() {
-            return 0;
-        }
-        self.plane::<u64>(self.layout().body_cells())[i]
-    }
-
     /// Sets the body table from an image (M12): the crushed count, the
     /// redraws since the last step and every slot (`body(i)`), then draws
     /// the bodies.

@@ -113,6 +113,8 @@ const fn crc_table() -> [u32; 256] {
 
 static CRC_TABLE: [u32; 256] = crc_table();
 
+/// Out of line: one copy for the writer and the reader.
+#[inline(never)]
 pub(crate) fn crc32(bytes: &[u8]) -> u32 {
     !bytes.iter().fold(!0u32, |r, &b| CRC_TABLE[((r ^ u32::from(b)) & 0xff) as usize] ^ (r >> 8))
 }
@@ -129,23 +131,33 @@ impl Put<'_> {
         self.out[self.at..self.at + b.len()].copy_from_slice(b);
         self.at += b.len();
     }
-    // Out of line, the value in a register: the image's fields are many,
-    // and each bounds check and copy inlined where it is written made most
-    // of the writer's code.
-    #[inline(never)]
     fn u8(&mut self, v: u8) {
         self.bytes(&[v]);
     }
-    #[inline(never)]
     fn u32(&mut self, v: u32) {
         self.bytes(&v.to_le_bytes());
     }
-    #[inline(never)]
     fn u64(&mut self, v: u64) {
         self.bytes(&v.to_le_bytes());
     }
     fn f32(&mut self, v: f32) {
         self.u32(v.to_bits());
+    }
+    /// Writes `N` bytes, those `f` writes, assembled in an array first:
+    /// every write of `f` is then at an offset known when compiled, and
+    /// none needs a check of its own (the image's fields are many, and
+    /// each checked write made most of the writer's code).
+    fn fixed<const N: usize>(&mut self, f: impl FnOnce(&mut Put<'_>)) {
+        let mut a = [0; N];
+        let mut q = Put { out: &mut a, at: 0 };
+        f(&mut q);
+        debug_assert_eq!(q.at, N);
+        self.bytes(&a);
+    }
+    /// A plane of floats. Out of line: one copy serves every plane.
+    #[inline(never)]
+    fn f32s(&mut self, plane: &[f32]) {
+        plane.iter().for_each(|&f| self.f32(f));
     }
 }
 
@@ -170,13 +182,6 @@ impl<'a> Get<'a> {
     }
     fn u8(&mut self) -> Result<u8, Error> {
         Ok(self.array::<1>()?[0])
-    }
-    fn flag(&mut self) -> Result<bool, Error> {
-        match self.u8()? {
-            0 => Ok(false),
-            1 => Ok(true),
-            _ => Err(Error::ImageInvalid),
-        }
     }
     fn u32(&mut self) -> Result<u32, Error> {
         Ok(u32::from_le_bytes(self.array()?))
@@ -347,12 +352,17 @@ fn put_desc(p: &mut Put<'_>, d: &Description) {
 
 fn get_desc(g: &mut Get<'_>) -> Result<Description, Error> {
     let bad = Error::ImageInvalid;
+    // Taken whole, then read from the copy: every read below is at an
+    // offset known when compiled, so none needs a check of its own.
+    let fixed: [u8; DESC] = g.array()?;
+    let g = &mut Get { rest: &fixed };
     let dim = g.u32()?;
     let size = [g.u32()?, g.u32()?, g.u32()?];
     let seed = g.u64()?;
+    let faces: [u8; 6] = g.array()?;
     let mut boundary = [[Boundary::Periodic; 2]; 3];
-    for face in boundary.iter_mut().flatten() {
-        *face = match g.u8()? {
+    for (face, &b) in boundary.iter_mut().flatten().zip(&faces) {
+        *face = match b {
             0 => Boundary::Periodic,
             1 => Boundary::Wall,
             2 => Boundary::Open,
@@ -364,33 +374,37 @@ fn get_desc(g: &mut Get<'_>) -> Result<Description, Error> {
         16 => Quantization::Bits16,
         _ => return Err(bad),
     };
-    let drift = match g.u8()? {
-        0 => Drift::Paper,
-        1 => Drift::Calibrated,
-        _ => return Err(bad),
+    // The flags, and the enumerations of two values, are converted as
+    // read and checked together at the end: valid when none is above 1,
+    // that is when they or'ed together are at most 1 (as `mpca_desc`'s
+    // conversion in the C library checks its own).
+    let mut ones = 0;
+    let mut one = |v: u8| {
+        ones |= v;
+        v & 1 != 0
     };
+    let drift = if one(g.u8()?) { Drift::Calibrated } else { Drift::Paper };
     let method = match g.u8()? {
         0 => Method::Exhaustive,
         1 => Method::ExactFast,
         2 => Method::Greedy,
         _ => return Err(bad),
     };
-    let collisions = match g.u8()? {
-        0 => Collisions::Paper,
-        1 => Collisions::SpeedLimited,
-        _ => return Err(bad),
-    };
-    let (per_particle_mass, obstacles, lifetimes, contacts) = (g.flag()?, g.flag()?, g.flag()?, g.flag()?);
-    let forces = Forces { uniform: g.flag()?, field: g.flag()?, potential: g.flag()?, vortex: g.flag()? };
-    let (energy_neutral, flow) = (g.flag()?, g.flag()?);
+    let collisions = if one(g.u8()?) { Collisions::SpeedLimited } else { Collisions::Paper };
+    let flags: [u8; 10] = g.array()?;
+    let [per_particle_mass, obstacles, lifetimes, contacts, uniform, field, potential, vortex, energy_neutral, flow] = flags.map(&mut one);
+    let forces = Forces { uniform, field, potential, vortex };
     let mass = g.f32()?;
     let (mass_classes, surface_capacity, emitter_capacity) = (g.u32()?, g.u32()?, g.u32()?);
     let gravity = [g.f32()?, g.f32()?, g.f32()?];
     let vortex = Vortex { centre: [g.f32()?, g.f32()?], core_radius: g.f32()?, circulation: g.f32()? };
     let (restitution, wall_restitution, dt) = (g.f32()?, g.f32()?, g.f32()?);
     let (rate, wind) = (g.f32()?, [g.f32()?, g.f32()?, g.f32()?]);
-    let drag = Drag { rate, wind, field: g.flag()?, vortex: flow };
+    let drag = Drag { rate, wind, field: one(g.u8()?), vortex: flow };
     let identity = Identity::from_bits(u32::from(g.u8()?)).ok_or(bad)?;
+    if ones > 1 {
+        return Err(bad);
+    }
     g.zeros(2)?;
     Ok(Description {
         dim,
@@ -960,40 +974,47 @@ impl World {
         let l = h.layout;
         let dim = self.dim();
         let mut p = Put { out, at: 0 };
-        p.bytes(&MAGIC);
         let bodies = body_bytes(&self.saved_desc()) > 0;
-        p.u32(if bodies { 3 } else { 2 });
-        p.u32(0);
-        p.u64(len as u64);
-        put_desc(&mut p, &h.desc);
+        p.fixed::<HEAD>(|p| {
+            p.bytes(&MAGIC);
+            p.u32(if bodies { 3 } else { 2 });
+            p.u32(0);
+            p.u64(len as u64);
+        });
+        p.fixed::<DESC>(|p| put_desc(p, &h.desc));
         #[cfg(feature = "obstacles")]
         if let Some((crushed, redraws)) = self.body_head() {
-            p.u32(h.desc.body_capacity);
-            p.u32(h.desc.body_surface_capacity);
-            p.u64(crushed);
-            p.u32(redraws);
-            p.u32(0);
+            p.fixed::<BODY_HEAD>(|p| {
+                p.u32(h.desc.body_capacity);
+                p.u32(h.desc.body_surface_capacity);
+                p.u64(crushed);
+                p.u32(redraws);
+                p.u32(0);
+            });
         }
-        p.u64(h.step);
-        let Counters { particles, emitted, exited, expired, shortfall, collisions, clamps, clamp_energy, displaced, processed, skipped } =
-            h.counters;
-        for c in [particles, emitted, exited, expired, shortfall, collisions, clamps] {
-            p.u64(c);
-        }
-        p.bytes(&u128::from(clamp_energy).to_le_bytes());
-        for c in [displaced, processed, skipped] {
-            p.u64(c);
-        }
-        for c in [h.masses, h.surfaces, h.emitters, h.ids_given] {
-            p.u32(c);
-        }
+        p.fixed::<STATE>(|p| {
+            p.u64(h.step);
+            let Counters { particles, emitted, exited, expired, shortfall, collisions, clamps, clamp_energy, displaced, processed, skipped } =
+                h.counters;
+            for c in [particles, emitted, exited, expired, shortfall, collisions, clamps] {
+                p.u64(c);
+            }
+            p.bytes(&u128::from(clamp_energy).to_le_bytes());
+            for c in [displaced, processed, skipped] {
+                p.u64(c);
+            }
+            for c in [h.masses, h.surfaces, h.emitters, h.ids_given] {
+                p.u32(c);
+            }
+        });
         let occupancy: &[u64] = self.plane(l.occupancy());
         occupancy.iter().for_each(|&w| p.u64(w));
         // The static obstacles: bodies are drawn again from their table
         // when the image is loaded (M13).
         let obstacle: &[u64] = self.plane(l.obstacle());
+        let body = self.body_cells();
         for (i, &w) in obstacle.iter().enumerate() {
-            p.u64(w & !self.body_word(i));
+            p.u64(w & !body.get(i).copied().unwrap_or(0));
         }
         // Per particle, in cell order: velocities, mass classes, lifetimes,
         // then ids, ages and tags.
@@ -1026,14 +1047,14 @@ impl World {
         if !tag.is_empty() {
             each_particle(&mut |cell| p.u8(tag[cell]));
         }
-        self.plane::<f32>(l.field()).iter().for_each(|&f| p.f32(f));
-        self.plane::<f32>(l.potential()).iter().for_each(|&u| p.f32(u));
-        self.plane::<f32>(l.wind()).iter().for_each(|&u| p.f32(u));
-        self.plane::<f32>(l.mass_table())[..h.masses as usize].iter().for_each(|&m| p.f32(m));
-        self.plane::<Surface>(l.surface())[..h.surfaces as usize].iter().for_each(|s| put_surface(&mut p, s));
-        self.plane::<Slot>(l.emitters())[..h.emitters as usize].iter().for_each(|s| put_slot(&mut p, s));
+        for plane in [l.field(), l.potential(), l.wind()] {
+            p.f32s(self.plane(plane));
+        }
+        p.f32s(&self.plane::<f32>(l.mass_table())[..h.masses as usize]);
+        self.plane::<Surface>(l.surface())[..h.surfaces as usize].iter().for_each(|s| p.fixed::<SURFACE>(|p| put_surface(p, s)));
+        self.plane::<Slot>(l.emitters())[..h.emitters as usize].iter().for_each(|s| p.fixed::<EMITTER>(|p| put_slot(p, s)));
         #[cfg(feature = "obstacles")]
-        self.body_table().iter().for_each(|b| put_body(&mut p, b));
+        self.body_table().iter().for_each(|b| p.fixed::<BODY>(|p| put_body(p, b)));
         let crc = crc32(&p.out[..len - CHECKSUM]);
         p.u32(crc);
         debug_assert_eq!(p.at, len);
