@@ -562,6 +562,8 @@ fn read(image: &[u8]) -> Result<Image<'_>, Error> {
     // M13: version 3 is a world with bodies, and only such a world.
     let (mut crushed, mut redraws) = (0, 0);
     if version == 3 {
+        let head: [u8; BODY_HEAD] = g.array()?;
+        let g = &mut Get { rest: &head };
         (desc.body_capacity, desc.body_surface_capacity, crushed, redraws) = (g.u32()?, g.u32()?, g.u64()?, g.u32()?);
         g.zeros(4)?;
         if !desc.obstacles || desc.body_capacity == 0 {
@@ -576,17 +578,20 @@ fn read(image: &[u8]) -> Result<Image<'_>, Error> {
     if desc.dim == 2 && desc.size[2] != 1 {
         return Err(bad);
     }
-    let step = g.u64()?;
+    // Read from a copy, as the description is.
+    let state: [u8; STATE] = g.array()?;
+    let s = &mut Get { rest: &state };
+    let step = s.u64()?;
     let [particles, emitted, exited, expired, shortfall, collisions, clamps] =
-        [g.u64()?, g.u64()?, g.u64()?, g.u64()?, g.u64()?, g.u64()?, g.u64()?];
+        [s.u64()?, s.u64()?, s.u64()?, s.u64()?, s.u64()?, s.u64()?, s.u64()?];
     // 16 bytes in the image; the world counts in a u64.
-    let clamp_energy = u64::try_from(u128::from_le_bytes(g.array()?)).map_err(|_| Error::ImageInvalid)?;
-    let [displaced, processed, skipped] = [g.u64()?, g.u64()?, g.u64()?];
+    let clamp_energy = u64::try_from(u128::from_le_bytes(s.array()?)).map_err(|_| Error::ImageInvalid)?;
+    let [displaced, processed, skipped] = [s.u64()?, s.u64()?, s.u64()?];
     let counters =
         Counters { particles, emitted, exited, expired, shortfall, collisions, clamps, clamp_energy, displaced, processed, skipped };
-    let [masses, surfaces, emitters] = [g.u32()?, g.u32()?, g.u32()?].map(|c| c as usize);
+    let [masses, surfaces, emitters] = [s.u32()?, s.u32()?, s.u32()?].map(|c| c as usize);
     // What was a reserved zero word: a world without ids gives none.
-    let ids_given = g.u32()?;
+    let ids_given = s.u32()?;
     if !desc.identity.ids() && ids_given != 0 {
         return Err(bad);
     }
