@@ -198,6 +198,12 @@ impl<'a> Get<'a> {
     }
 }
 
+/// The first `N` bytes of `b`: checked once, so that the reads at fixed
+/// offsets in it that follow need no check of their own.
+fn first<const N: usize>(b: &[u8]) -> &[u8; N] {
+    b.first_chunk().unwrap()
+}
+
 /// Word `i` of a plane of little-endian `u32` in an image.
 fn le_u32(bytes: &[u8], i: usize) -> u32 {
     let mut a = [0; 4];
@@ -445,6 +451,7 @@ fn put_surface(p: &mut Put<'_>, s: &Surface) {
 }
 
 fn get_surface(b: &[u8]) -> Surface {
+    let b = first::<SURFACE>(b);
     let f = |i| f32::from_bits(le_u32(b, i));
     Surface { cell: le_u32(b, 0), normal: [f(1), f(2), f(3)], restitution: f(4), from_mask: le_u32(b, 5) }
 }
@@ -919,6 +926,7 @@ fn put_body(p: &mut Put<'_>, b: &crate::rules::body::Body) {
 #[cfg(feature = "obstacles")]
 fn get_body(b: &[u8]) -> crate::rules::body::Body {
     use crate::rules::body::{Body, Tally};
+    let b = first::<BODY>(b);
     let f = |i| f32::from_bits(le_u32(b, i));
     let tally = |w: usize| Tally {
         momentum: [0, 1, 2].map(|k| le_u64(&b[4 * w..], k) as i64),
