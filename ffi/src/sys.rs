@@ -200,7 +200,15 @@ pub(crate) fn die(info: &core::panic::PanicInfo<'_>) -> ! {
     }
     let mut line = Line(heapless::Vec::new());
     let _ = match info.location() {
-        Some(at) => core::fmt::write(&mut line, format_args!("mpca: panicked at {at}: {}", info.message())),
+        // The location's parts written one by one: `{at}` would pass the
+        // file name through `Formatter::pad`, a large routine that no
+        // other message of this library calls.
+        Some(at) => {
+            use core::fmt::Write;
+            let _ = line.write_str("mpca: panicked at ");
+            let _ = line.write_str(at.file());
+            core::fmt::write(&mut line, format_args!(":{}:{}: {}", at.line(), at.column(), info.message()))
+        }
         None => core::fmt::write(&mut line, format_args!("mpca: panicked: {}", info.message())),
     };
     // The room write_str kept.
