@@ -309,8 +309,9 @@ impl Layout {
         let mut at = 0usize;
         for p in &mut plane {
             p.off = at;
-            at = at.checked_add(p.len).and_then(|e| e.checked_add(7)).ok_or(Error::TooLarge)? & !7;
-            // Slices may not exceed isize::MAX bytes.
+            // Saturating: a sum past usize::MAX is past the bound below
+            // too. Slices may not exceed isize::MAX bytes.
+            at = at.saturating_add(p.len).saturating_add(7) & !7;
             if at > isize::MAX as usize / 2 {
                 return Err(Error::TooLarge);
             }
