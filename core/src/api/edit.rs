@@ -4,9 +4,9 @@
 
 use crate::Error;
 use crate::api::query::Particle;
-use crate::rules::quant::{with_quant, Quant};
+use crate::rules::quant::Width;
 use crate::storage::cells::Cells;
-use crate::storage::layout::{mark, put_bit, Site};
+use crate::storage::layout::{mark, put_bit, store, Site};
 use crate::storage::world::World;
 
 /// Whether stored components `q`, in quanta (`scale` to a cell per step),
@@ -43,10 +43,8 @@ impl World {
         if v.iter().any(|c| c.abs() > 1.0) {
             return Err(Error::SpeedRange);
         }
-        let ok = with_quant!(self.head.desc.quantization, Q => {
-            storable(v.map(|c| Q::nearest(c).to_int()), Q::SCALE as i32)
-        });
-        if !ok {
+        let width = Width::of_quantization(self.head.desc.quantization);
+        if !storable(v.map(|c| width.nearest(c)), width.scale()) {
             return Err(Error::SpeedRange);
         }
         Ok(v)
@@ -134,24 +132,27 @@ impl World {
         if identity.any() {
             self.identify(s.cell, tag);
         }
-        with_quant!(self.head.desc.quantization, Q => {
-            let (_, p) = self.planes::<Q>();
-            put_bit(Cells::new(p.occupancy), s.bit, true);
-            mark(Cells::new(p.rows), Cells::new(p.words), summary_words, s.row, s.x);
-            let r = stream.map(|rng| rng.next_u64());
-            for k in 0..d {
-                p.velocity[s.cell * d + k] = match (v, r) {
-                    (Velocity::Fine(x), r) => Q::from_int(Q::stochastic(x[k], (r.unwrap_or(0) >> (16 * k)) as u32)),
-                    (Velocity::Float(v), _) => Q::nearest(v[k]),
-                };
-            }
-            if per_mass {
-                p.mass_index[s.cell] = mass_index;
-            }
-            if lifetimes {
-                p.life[s.cell] = life;
-            }
-        });
+        // The velocities as bytes of the world's width (`store`): one copy
+        // of this for both widths.
+        let width = Width::of_quantization(self.head.desc.quantization);
+        let bytes = if width.wide() { 2 } else { 1 };
+        let (_, p) = self.planes::<u8>();
+        put_bit(Cells::new(p.occupancy), s.bit, true);
+        mark(Cells::new(p.rows), Cells::new(p.words), summary_words, s.row, s.x);
+        let r = stream.map(|rng| rng.next_u64());
+        for k in 0..d {
+            let q = match (v, r) {
+                (Velocity::Fine(x), r) => width.stochastic(x[k], (r.unwrap_or(0) >> (16 * k)) as u32).clamp(-width.scale(), width.scale()),
+                (Velocity::Float(v), _) => width.nearest(v[k]),
+            };
+            store(p.velocity, s.cell * d + k, bytes, q);
+        }
+        if per_mass {
+            p.mass_index[s.cell] = mass_index;
+        }
+        if lifetimes {
+            p.life[s.cell] = life;
+        }
     }
 
     /// Gives the particle just placed in `cell` the next id, age 0 and
