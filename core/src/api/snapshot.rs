@@ -47,7 +47,7 @@ use crate::rules::emitter::{checked, Emitter, EmitterStats, Slot};
 use crate::rules::obstacle::Surface;
 use crate::rules::quant::{with_quant, Quant};
 use crate::storage::cells::Cells;
-use crate::storage::layout::{mark, store, Layout};
+use crate::storage::layout::{mark, view, Layout};
 use crate::storage::world::{Counters, World};
 
 /// The first eight bytes of every image.
@@ -253,6 +253,48 @@ fn each_bit(l: &Layout, word: impl Fn(usize) -> u64, mut f: impl FnMut(usize, us
 #[inline(never)]
 fn each_cell(l: &Layout, occupancy: &[u64], f: &mut dyn FnMut(usize)) {
     each_bit(l, |i| occupancy[i], |row, x| f(x + l.n[0] * row));
+}
+
+/// A value of a plane of one or more values per particle, as an image
+/// holds it: little-endian.
+trait Le: Copy {
+    /// The value in the first bytes of `b`.
+    fn le(b: &[u8]) -> Self;
+}
+
+impl Le for u8 {
+    fn le(b: &[u8]) -> u8 {
+        b[0]
+    }
+}
+
+impl Le for u16 {
+    fn le(b: &[u8]) -> u16 {
+        u16::from_le_bytes([b[0], b[1]])
+    }
+}
+
+impl Le for u32 {
+    fn le(b: &[u8]) -> u32 {
+        le_u32(b, 0)
+    }
+}
+
+/// Writes a plane of an image of `per` values a particle, `from`, into the
+/// world's plane `to`: the particles' values in cell order, each where the
+/// occupancy plane `occupancy` of a world planned as `l` has it. A plane
+/// the image does not hold is empty there, and writes nothing. Out of
+/// line: one copy for every plane of a width.
+#[inline(never)]
+fn scatter<T: Le>(l: &Layout, occupancy: &[u64], from: &[u8], per: usize, to: &mut [T]) {
+    let mut from = from.chunks_exact(per * size_of::<T>());
+    each_cell(l, occupancy, &mut |cell| {
+        if let Some(values) = from.next() {
+            for (k, b) in values.chunks_exact(size_of::<T>()).enumerate() {
+                to[cell * per + k] = T::le(b);
+            }
+        }
+    });
 }
 
 /// Bytes of the image of a world described by `d`, planned as `l`, with
@@ -846,40 +888,35 @@ fn apply(w: &mut World, img: &Image<'_>) {
             p.age.fill(0);
             p.tag.fill(0);
         }
-        // The skip summaries (M3), exact: flagged where a particle is.
+        // The skip summaries (M3), exact: flagged where a particle is,
+        // every word holding one.
         p.rows.fill(0);
         p.words.fill(0);
         let (rows, words) = (Cells::new(&mut *p.rows), Cells::new(&mut *p.words));
-        let (width, scale) = width_and_scale(d.quantization);
-        let mut i = 0;
-        each_bit(&l, |k| le_u64(img.occupancy, k), |row, x| {
-            mark(rows, words, l.summary_words, row, x);
-            let cell = x + l.n[0] * row;
-            for k in 0..dim {
-                store(p.velocity, cell * dim + k, width, component(&img.velocity[(i * dim + k) * width..], width).clamp(-scale, scale));
+        for (i, &word) in p.occupancy.iter().enumerate() {
+            if word != 0 {
+                mark(rows, words, l.summary_words, i / l.row_words, i % l.row_words * 64);
             }
-            if d.per_particle_mass {
-                p.mass_index[cell] = img.mass_index[i];
-            }
-            if d.lifetimes {
-                p.life[cell] = u16::from_le_bytes([img.life[2 * i], img.life[2 * i + 1]]);
-            }
-            // M6b: an image with these planes reads only where they are
-            // built (`read` refuses others).
-            #[cfg(feature = "identity")]
-            {
-                if d.identity.ids() {
-                    p.id[cell] = le_u32(img.id, i);
-                }
-                if d.identity.ages() {
-                    p.age[cell] = le_u32(img.age, i);
-                }
-                if d.identity.tags() {
-                    p.tag[cell] = img.tag[i];
-                }
-            }
-            i += 1;
-        });
+        }
+        // Plane by plane, the particles' values in cell order. The
+        // velocities as the image holds them: `check` refused any
+        // component beyond the width's scale.
+        let occupancy = &*p.occupancy;
+        if width_and_scale(d.quantization).0 == 1 {
+            scatter::<u8>(&l, occupancy, img.velocity, dim, p.velocity);
+        } else {
+            scatter::<u16>(&l, occupancy, img.velocity, dim, view(p.velocity));
+        }
+        scatter::<u8>(&l, occupancy, img.mass_index, 1, p.mass_index);
+        scatter::<u16>(&l, occupancy, img.life, 1, p.life);
+        // M6b: an image with these planes reads only where they are
+        // built (`read` refuses others).
+        #[cfg(feature = "identity")]
+        {
+            scatter::<u32>(&l, occupancy, img.id, 1, p.id);
+            scatter::<u32>(&l, occupancy, img.age, 1, p.age);
+            scatter::<u8>(&l, occupancy, img.tag, 1, p.tag);
+        }
         for (plane, bytes) in [(p.field, img.field), (p.potential, img.potential), (p.wind, img.wind)] {
             for (k, f) in plane.iter_mut().enumerate() {
                 *f = f32::from_bits(le_u32(bytes, k));
