@@ -45,7 +45,6 @@ use crate::api::edit::storable;
 use crate::rules::assign::Method;
 use crate::rules::emitter::{checked, Emitter, EmitterStats, Slot};
 use crate::rules::obstacle::Surface;
-use crate::rules::quant::{with_quant, Quant};
 use crate::storage::cells::Cells;
 use crate::storage::layout::{mark, view, Layout};
 use crate::storage::world::{Counters, World};
@@ -260,11 +259,16 @@ fn each_cell(l: &Layout, occupancy: &[u64], f: &mut dyn FnMut(usize)) {
 trait Le: Copy {
     /// The value in the first bytes of `b`.
     fn le(b: &[u8]) -> Self;
+    /// Writes the value.
+    fn put(self, p: &mut Put<'_>);
 }
 
 impl Le for u8 {
     fn le(b: &[u8]) -> u8 {
         b[0]
+    }
+    fn put(self, p: &mut Put<'_>) {
+        p.u8(self);
     }
 }
 
@@ -272,12 +276,35 @@ impl Le for u16 {
     fn le(b: &[u8]) -> u16 {
         u16::from_le_bytes([b[0], b[1]])
     }
+    fn put(self, p: &mut Put<'_>) {
+        p.bytes(&self.to_le_bytes());
+    }
 }
 
 impl Le for u32 {
     fn le(b: &[u8]) -> u32 {
         le_u32(b, 0)
     }
+    fn put(self, p: &mut Put<'_>) {
+        p.u32(self);
+    }
+}
+
+/// Writes the world's plane `plane` of `per` values a cell as an image
+/// holds it: the values of the cells set in the occupancy plane
+/// `occupancy` of a world planned as `l`, in cell order. An empty plane
+/// (one the world does not keep) writes nothing. Out of line: one copy
+/// for every plane of a width.
+#[inline(never)]
+fn gather<T: Le>(p: &mut Put<'_>, l: &Layout, occupancy: &[u64], plane: &[T], per: usize) {
+    if plane.is_empty() {
+        return;
+    }
+    each_cell(l, occupancy, &mut |cell| {
+        for k in 0..per {
+            plane[cell * per + k].put(p);
+        }
+    });
 }
 
 /// Writes a plane of an image of `per` values a particle, `from`, into the
@@ -1067,36 +1094,19 @@ impl World {
             p.u64(w & !body.get(i).copied().unwrap_or(0));
         }
         // Per particle, in cell order: velocities, mass classes, lifetimes,
-        // then ids, ages and tags.
-        let each_particle = |f: &mut dyn FnMut(usize)| each_cell(&l, occupancy, f);
-        with_quant!(h.desc.quantization, Q => {
-            let v: &[Q] = self.plane(l.velocity());
-            each_particle(&mut |cell| {
-                for k in 0..dim {
-                    // The low byte of an i16 is the i8 itself.
-                    p.bytes(&(v[cell * dim + k].to_int() as i16).to_le_bytes()[..size_of::<Q>()]);
-                }
-            });
-        });
-        if h.desc.per_particle_mass {
-            let index: &[u8] = self.plane(l.mass_index());
-            each_particle(&mut |cell| p.u8(index[cell]));
+        // then ids, ages and tags. The velocities as stored: an 8-bit
+        // component is its byte, a 16-bit one its two.
+        if width_and_scale(h.desc.quantization).0 == 1 {
+            gather::<u8>(&mut p, &l, occupancy, self.plane(l.velocity()), dim);
+        } else {
+            gather::<u16>(&mut p, &l, occupancy, self.plane(l.velocity()), dim);
         }
-        if h.desc.lifetimes {
-            let life: &[u16] = self.plane(l.life());
-            each_particle(&mut |cell| p.bytes(&life[cell].to_le_bytes()));
-        }
+        gather::<u8>(&mut p, &l, occupancy, self.plane(l.mass_index()), 1);
+        gather::<u16>(&mut p, &l, occupancy, self.plane(l.life()), 1);
         // M6b: ids, ages, tags.
-        for plane in [l.id(), l.age()] {
-            let values: &[u32] = self.plane(plane);
-            if !values.is_empty() {
-                each_particle(&mut |cell| p.u32(values[cell]));
-            }
-        }
-        let tag: &[u8] = self.plane(l.tag());
-        if !tag.is_empty() {
-            each_particle(&mut |cell| p.u8(tag[cell]));
-        }
+        gather::<u32>(&mut p, &l, occupancy, self.plane(l.id()), 1);
+        gather::<u32>(&mut p, &l, occupancy, self.plane(l.age()), 1);
+        gather::<u8>(&mut p, &l, occupancy, self.plane(l.tag()), 1);
         for plane in [l.field(), l.potential(), l.wind()] {
             p.f32s(self.plane(plane));
         }
