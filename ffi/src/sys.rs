@@ -135,6 +135,8 @@ impl<T> Lock<T> {
 
     /// Waits until the lock is free and takes it; the returned guard frees
     /// it when dropped, also when a panic unwinds (catch-panics builds).
+    /// Out of line: one copy for every use of the registry.
+    #[inline(never)]
     pub(crate) fn lock(&self) -> Held<'_, T> {
         let mut waited = 0u32;
         while self.held.compare_exchange_weak(false, true, Ordering::Acquire, Ordering::Relaxed).is_err() {
