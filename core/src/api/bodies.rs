@@ -144,7 +144,9 @@ impl crate::Description {
 
 impl World {
     /// The body table's head and slots; `NotEnabled` in a world without
-    /// bodies (M13: `obstacles` and a `body_capacity`).
+    /// bodies (M13: `obstacles` and a `body_capacity`). Out of line: one
+    /// copy for every call that reads the table.
+    #[inline(never)]
     fn bodies(&self) -> Result<(BodiesHead, &[Body]), Error> {
         if !self.head.desc.has_bodies() {
             return Err(Error::NotEnabled);
