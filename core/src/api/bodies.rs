@@ -271,12 +271,25 @@ impl World {
 
     /// Calls `f` with what drawing the bodies reads of this world, with
     /// `change` made to its table (none: `slot` past the table).
-    fn with_draw<R>(&self, change: Change, f: impl FnOnce(&Draw<'_>) -> R) -> R {
+    fn with_draw<R: Default>(&self, change: Change, f: impl FnOnce(&Draw<'_>) -> R) -> R {
+        let (mut f, mut out) = (Some(f), R::default());
+        self.draw(change, &mut |d| {
+            if let Some(f) = f.take() {
+                out = f(d);
+            }
+        });
+        out
+    }
+
+    /// [`World::with_draw`]'s work, `f` called once. Not generic: one
+    /// copy of the views of the table and the static obstacles (and of
+    /// their tables of calls) for every caller.
+    fn draw(&self, change: Change, f: &mut dyn FnMut(&Draw<'_>)) {
         let table = self.body_table();
         let l = *self.layout();
         let body = |i: usize| if i == change.slot { change.body } else { table[i] };
         let is_static = |c: [usize; 3]| self.is_static(l.site(c[0], c[1], c[2]));
-        f(&Draw { frame: self.frame(), count: table.len(), body: &body, is_static: &is_static })
+        f(&Draw { frame: self.frame(), count: table.len(), body: &body, is_static: &is_static });
     }
 
     /// Makes `change` and redraws every body (M13): refused whole where
