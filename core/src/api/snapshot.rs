@@ -1040,6 +1040,8 @@ impl World {
     /// Bytes of the image [`World::save`] writes now: a fixed head and state,
     /// the occupancy and obstacle bit planes, a few bytes per particle,
     /// the force and wind planes, and the used entries of the tables (M12).
+    // Out of line: one copy for the writer and the C library's exports.
+    #[inline(never)]
     pub fn snapshot_bytes(&self) -> usize {
         let h = &self.head;
         let occupancy: &[u64] = self.plane(h.layout.occupancy());
