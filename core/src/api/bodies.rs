@@ -514,6 +514,7 @@ impl World {
 }
 
 /// Calls `f` with every cell of the box `lo..hi`, in cell order.
+#[inline(never)]
 fn for_cells(lo: [usize; 3], hi: [usize; 3], f: &mut dyn FnMut([usize; 3])) {
     for z in lo[2]..hi[2] {
         for y in lo[1]..hi[1] {
