@@ -4,9 +4,9 @@
 
 use crate::Error;
 use crate::api::query::Particle;
-use crate::rules::quant::Width;
+use crate::rules::quant::{with_quant, Quant, Width};
 use crate::storage::cells::Cells;
-use crate::storage::layout::{mark, put_bit, store, Site};
+use crate::storage::layout::{mark, put_bit, view, Site};
 use crate::storage::world::World;
 
 /// Whether stored components `q`, in quanta (`scale` to a cell per step),
@@ -132,21 +132,22 @@ impl World {
         if identity.any() {
             self.identify(s.cell, tag);
         }
-        // The velocities as bytes of the world's width (`store`): one copy
-        // of this for both widths.
-        let width = Width::of_quantization(self.head.desc.quantization);
-        let bytes = if width.wide() { 2 } else { 1 };
+        let quantization = self.head.desc.quantization;
         let (_, p) = self.planes::<u8>();
         put_bit(Cells::new(p.occupancy), s.bit, true);
         mark(Cells::new(p.rows), Cells::new(p.words), summary_words, s.row, s.x);
         let r = stream.map(|rng| rng.next_u64());
-        for k in 0..d {
-            let q = match (v, r) {
-                (Velocity::Fine(x), r) => width.stochastic(x[k], (r.unwrap_or(0) >> (16 * k)) as u32).clamp(-width.scale(), width.scale()),
-                (Velocity::Float(v), _) => width.nearest(v[k]),
-            };
-            store(p.velocity, s.cell * d + k, bytes, q);
-        }
+        // The velocity alone in the world's type: the rest is one copy for
+        // both widths.
+        with_quant!(quantization, Q => {
+            let (width, velocity) = (Width::of::<Q>(), view::<Q>(p.velocity));
+            for k in 0..d {
+                velocity[s.cell * d + k] = Q::from_int(match (v, r) {
+                    (Velocity::Fine(x), r) => width.stochastic(x[k], (r.unwrap_or(0) >> (16 * k)) as u32),
+                    (Velocity::Float(v), _) => width.nearest(v[k]),
+                });
+            }
+        });
         if per_mass {
             p.mass_index[s.cell] = mass_index;
         }
