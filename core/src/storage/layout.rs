@@ -428,7 +428,9 @@ pub(crate) struct Site {
 /// Writes stored component `i` of a velocity plane of `width`-byte
 /// components (1, or 2 in the target's byte order) viewed as bytes: `q`,
 /// in quanta, within the width's range. Callers that hold the plane as
-/// bytes have one copy of their code for both widths.
+/// bytes have one copy of their code for both widths: the bodies'
+/// push-out (M13), which a build without `obstacles` does not have.
+#[cfg(feature = "obstacles")]
 #[inline(always)]
 pub(crate) fn store(plane: &mut [u8], i: usize, width: usize, q: i32) {
     if width == 1 || !cfg!(feature = "q16") {
