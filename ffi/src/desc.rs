@@ -218,6 +218,8 @@ fn boundary_from_c(v: u32) -> Result<Boundary, Refusal> {
 
 impl mpca_desc {
     /// A constant function, so that [`DEFAULTS`] is built at compile time.
+    /// Out of line where it runs: one copy for the exports that call it.
+    #[inline(never)]
     pub(crate) const fn from_core(d: &Description) -> mpca_desc {
         let f = d.forces;
         let mut boundary = [[0; 2]; 3];

@@ -269,6 +269,8 @@ impl<T> Lock<T> {
 
     /// Waits until the lock is free and takes it; the returned guard frees
     /// it when dropped, also when a panic unwinds (catch-panics builds).
+    /// Out of line: one copy for every use of the registry.
+    #[inline(never)]
     pub(crate) fn lock(&self) -> Held<'_, T> {
         let mut waited = 0u32;
         while self.held.compare_exchange_weak(false, true, Ordering::Acquire, Ordering::Relaxed).is_err() {
@@ -334,7 +336,15 @@ pub(crate) fn die(info: &core::panic::PanicInfo<'_>) -> ! {
     }
     let mut line = Line(heapless::Vec::new());
     let _ = match info.location() {
-        Some(at) => core::fmt::write(&mut line, format_args!("mpca: panicked at {at}: {}", info.message())),
+        // The location's parts written one by one: `{at}` would pass the
+        // file name through `Formatter::pad`, a large routine that no
+        // other message of this library calls.
+        Some(at) => {
+            use core::fmt::Write;
+            let _ = line.write_str("mpca: panicked at ");
+            let _ = line.write_str(at.file());
+            core::fmt::write(&mut line, format_args!(":{}:{}: {}", at.line(), at.column(), info.message()))
+        }
         None => core::fmt::write(&mut line, format_args!("mpca: panicked: {}", info.message())),
     };
     // The room write_str kept.

@@ -149,7 +149,9 @@ impl crate::Description {
 
 impl World {
     /// The body table's head and slots; `NotEnabled` in a world without
-    /// bodies (M13: `obstacles` and a `body_capacity`).
+    /// bodies (M13: `obstacles` and a `body_capacity`). Out of line: one
+    /// copy for every call that reads the table.
+    #[inline(never)]
     fn bodies(&self) -> Result<(BodiesHead, &[Body]), Error> {
         if !self.head.desc.has_bodies() {
             return Err(Error::new(ErrorKind::NotEnabled, NO_BODIES));
@@ -202,14 +204,6 @@ impl World {
     /// Every slot of the body table, free ones too; none without bodies.
     pub(crate) fn body_table(&self) -> &[Body] {
         self.bodies().map_or(&[][..], |(_, t)| t)
-    }
-
-    /// Word `i` of the body cell plane, 0 without bodies.
-    pub(crate) fn body_word_of(&self, i: usize) -> u64 {
-        if self.bodies().is_err() {
-            return 0;
-        }
-        self.plane::<u64>(self.layout().body_cells())[i]
     }
 
     /// Sets the body table from an image (M12): the crushed count, the
@@ -282,12 +276,25 @@ impl World {
 
     /// Calls `f` with what drawing the bodies reads of this world, with
     /// `change` made to its table (none: `slot` past the table).
-    fn with_draw<R>(&self, change: Change, f: impl FnOnce(&Draw<'_>) -> R) -> R {
+    fn with_draw<R: Default>(&self, change: Change, f: impl FnOnce(&Draw<'_>) -> R) -> R {
+        let (mut f, mut out) = (Some(f), R::default());
+        self.draw(change, &mut |d| {
+            if let Some(f) = f.take() {
+                out = f(d);
+            }
+        });
+        out
+    }
+
+    /// [`World::with_draw`]'s work, `f` called once. Not generic: one
+    /// copy of the views of the table and the static obstacles (and of
+    /// their tables of calls) for every caller.
+    fn draw(&self, change: Change, f: &mut dyn FnMut(&Draw<'_>)) {
         let table = self.body_table();
         let l = *self.layout();
         let body = |i: usize| if i == change.slot { change.body } else { table[i] };
         let is_static = |c: [usize; 3]| self.is_static(l.site(c[0], c[1], c[2]));
-        f(&Draw { frame: self.frame(), count: table.len(), body: &body, is_static: &is_static })
+        f(&Draw { frame: self.frame(), count: table.len(), body: &body, is_static: &is_static });
     }
 
     /// Makes `change` and redraws every body (M13): refused whole where
@@ -512,6 +519,7 @@ impl World {
 }
 
 /// Calls `f` with every cell of the box `lo..hi`, in cell order.
+#[inline(never)]
 fn for_cells(lo: [usize; 3], hi: [usize; 3], f: &mut dyn FnMut([usize; 3])) {
     for z in lo[2]..hi[2] {
         for y in lo[1]..hi[1] {

@@ -6,9 +6,9 @@ use core::ffi::CStr;
 
 use crate::{Error, ErrorKind};
 use crate::api::query::Particle;
-use crate::rules::quant::{with_quant, Quant};
+use crate::rules::quant::{with_quant, Quant, Width};
 use crate::storage::cells::Cells;
-use crate::storage::layout::{mark, put_bit, Site};
+use crate::storage::layout::{mark, put_bit, view, Site};
 use crate::storage::world::World;
 
 /// Whether stored components `q`, in quanta (`scale` to a cell per step),
@@ -45,10 +45,8 @@ impl World {
         if v.iter().any(|c| c.abs() > 1.0) {
             return Err(Error::new(ErrorKind::SpeedRange, c"velocity"));
         }
-        let ok = with_quant!(self.head.desc.quantization, Q => {
-            storable(v.map(|c| Q::nearest(c).to_int()), Q::SCALE as i32)
-        });
-        if !ok {
+        let width = Width::of_quantization(self.head.desc.quantization);
+        if !storable(v.map(|c| width.nearest(c)), width.scale()) {
             return Err(Error::new(ErrorKind::SpeedRange, c"velocity"));
         }
         Ok(v)
@@ -137,24 +135,28 @@ impl World {
         if identity.any() {
             self.identify(s.cell, tag);
         }
-        with_quant!(self.head.desc.quantization, Q => {
-            let (_, p) = self.planes::<Q>();
-            put_bit(Cells::new(p.occupancy), s.bit, true);
-            mark(Cells::new(p.rows), Cells::new(p.words), summary_words, s.row, s.x);
-            let r = stream.map(|rng| rng.next_u64());
+        let quantization = self.head.desc.quantization;
+        let (_, p) = self.planes::<u8>();
+        put_bit(Cells::new(p.occupancy), s.bit, true);
+        mark(Cells::new(p.rows), Cells::new(p.words), summary_words, s.row, s.x);
+        let r = stream.map(|rng| rng.next_u64());
+        // The velocity alone in the world's type: the rest is one copy for
+        // both widths.
+        with_quant!(quantization, Q => {
+            let (width, velocity) = (Width::of::<Q>(), view::<Q>(p.velocity));
             for k in 0..d {
-                p.velocity[s.cell * d + k] = match (v, r) {
-                    (Velocity::Fine(x), r) => Q::from_int(Q::stochastic(x[k], (r.unwrap_or(0) >> (16 * k)) as u32)),
-                    (Velocity::Float(v), _) => Q::nearest(v[k]),
-                };
-            }
-            if per_mass {
-                p.mass_index[s.cell] = mass_index;
-            }
-            if lifetimes {
-                p.life[s.cell] = life;
+                velocity[s.cell * d + k] = Q::from_int(match (v, r) {
+                    (Velocity::Fine(x), r) => width.stochastic(x[k], (r.unwrap_or(0) >> (16 * k)) as u32),
+                    (Velocity::Float(v), _) => width.nearest(v[k]),
+                });
             }
         });
+        if per_mass {
+            p.mass_index[s.cell] = mass_index;
+        }
+        if lifetimes {
+            p.life[s.cell] = life;
+        }
     }
 
     /// Gives the particle just placed in `cell` the next id, age 0 and

@@ -377,6 +377,8 @@ impl World {
     /// Adds a shape's cells as obstacles with restitution `e`, normals from
     /// the shape's exact geometry (M7). [`World::surface_entries`] says how
     /// many surface entries it takes.
+    // Out of line: one copy for the C library's exports of every shape.
+    #[inline(never)]
     pub fn add_shape(&mut self, shape: Shape, e: f32) -> Result<(), Error> {
         Addition::of_shape(shape, &self.frame(), &mut |a| self.add_obstacles(a, e, false).map(|()| 0)).map(drop)
     }

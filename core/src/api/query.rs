@@ -343,6 +343,9 @@ pub struct Particles<'a> {
 impl Iterator for Particles<'_> {
     type Item = Particle;
 
+    /// Out of line: one copy for every loop over the particles (the C
+    /// library's exports each have one).
+    #[inline(never)]
     fn next(&mut self) -> Option<Particle> {
         let (pos, cell) = self.cells.next()?;
         Some(self.world.particle_at(pos, cell))

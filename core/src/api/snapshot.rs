@@ -47,9 +47,8 @@ use crate::api::edit::storable;
 use crate::rules::assign::Method;
 use crate::rules::emitter::{checked, Emitter, EmitterStats, Slot};
 use crate::rules::obstacle::Surface;
-use crate::rules::quant::{with_quant, Quant};
 use crate::storage::cells::Cells;
-use crate::storage::layout::{mark, store, Layout};
+use crate::storage::layout::{mark, view, Layout};
 use crate::storage::world::{Counters, World};
 
 /// The first eight bytes of every image.
@@ -115,6 +114,8 @@ const fn crc_table() -> [u32; 256] {
 
 static CRC_TABLE: [u32; 256] = crc_table();
 
+/// Out of line: one copy for the writer and the reader.
+#[inline(never)]
 pub(crate) fn crc32(bytes: &[u8]) -> u32 {
     !bytes.iter().fold(!0u32, |r, &b| CRC_TABLE[((r ^ u32::from(b)) & 0xff) as usize] ^ (r >> 8))
 }
@@ -131,23 +132,33 @@ impl Put<'_> {
         self.out[self.at..self.at + b.len()].copy_from_slice(b);
         self.at += b.len();
     }
-    // Out of line, the value in a register: the image's fields are many,
-    // and each bounds check and copy inlined where it is written made most
-    // of the writer's code.
-    #[inline(never)]
     fn u8(&mut self, v: u8) {
         self.bytes(&[v]);
     }
-    #[inline(never)]
     fn u32(&mut self, v: u32) {
         self.bytes(&v.to_le_bytes());
     }
-    #[inline(never)]
     fn u64(&mut self, v: u64) {
         self.bytes(&v.to_le_bytes());
     }
     fn f32(&mut self, v: f32) {
         self.u32(v.to_bits());
+    }
+    /// Writes `N` bytes, those `f` writes, assembled in an array first:
+    /// every write of `f` is then at an offset known when compiled, and
+    /// none needs a check of its own (the image's fields are many, and
+    /// each checked write made most of the writer's code).
+    fn fixed<const N: usize>(&mut self, f: impl FnOnce(&mut Put<'_>)) {
+        let mut a = [0; N];
+        let mut q = Put { out: &mut a, at: 0 };
+        f(&mut q);
+        debug_assert_eq!(q.at, N);
+        self.bytes(&a);
+    }
+    /// A plane of floats. Out of line: one copy serves every plane.
+    #[inline(never)]
+    fn f32s(&mut self, plane: &[f32]) {
+        plane.iter().for_each(|&f| self.f32(f));
     }
 }
 
@@ -173,13 +184,6 @@ impl<'a> Get<'a> {
     fn u8(&mut self) -> Result<u8, Error> {
         Ok(self.array::<1>()?[0])
     }
-    fn flag(&mut self) -> Result<bool, Error> {
-        match self.u8()? {
-            0 => Ok(false),
-            1 => Ok(true),
-            _ => Err(invalid(c"desc (a flag)")),
-        }
-    }
     fn u32(&mut self) -> Result<u32, Error> {
         Ok(u32::from_le_bytes(self.array()?))
     }
@@ -193,6 +197,12 @@ impl<'a> Get<'a> {
     fn zeros(&mut self, n: usize) -> Result<(), Error> {
         if self.take(n)?.iter().all(|&b| b == 0) { Ok(()) } else { Err(invalid(RESERVED)) }
     }
+}
+
+/// The first `N` bytes of `b`: checked once, so that the reads at fixed
+/// offsets in it that follow need no check of their own.
+fn first<const N: usize>(b: &[u8]) -> &[u8; N] {
+    b.first_chunk().unwrap()
 }
 
 /// Word `i` of a plane of little-endian `u32` in an image.
@@ -244,6 +254,76 @@ fn each_bit(l: &Layout, word: impl Fn(usize) -> u64, mut f: impl FnMut(usize, us
 #[inline(never)]
 fn each_cell(l: &Layout, occupancy: &[u64], f: &mut dyn FnMut(usize)) {
     each_bit(l, |i| occupancy[i], |row, x| f(x + l.n[0] * row));
+}
+
+/// A value of a plane of one or more values per particle, as an image
+/// holds it: little-endian.
+trait Le: Copy {
+    /// The value in the first bytes of `b`.
+    fn le(b: &[u8]) -> Self;
+    /// Writes the value.
+    fn put(self, p: &mut Put<'_>);
+}
+
+impl Le for u8 {
+    fn le(b: &[u8]) -> u8 {
+        b[0]
+    }
+    fn put(self, p: &mut Put<'_>) {
+        p.u8(self);
+    }
+}
+
+impl Le for u16 {
+    fn le(b: &[u8]) -> u16 {
+        u16::from_le_bytes([b[0], b[1]])
+    }
+    fn put(self, p: &mut Put<'_>) {
+        p.bytes(&self.to_le_bytes());
+    }
+}
+
+impl Le for u32 {
+    fn le(b: &[u8]) -> u32 {
+        le_u32(b, 0)
+    }
+    fn put(self, p: &mut Put<'_>) {
+        p.u32(self);
+    }
+}
+
+/// Writes the world's plane `plane` of `per` values a cell as an image
+/// holds it: the values of the cells set in the occupancy plane
+/// `occupancy` of a world planned as `l`, in cell order. An empty plane
+/// (one the world does not keep) writes nothing. Out of line: one copy
+/// for every plane of a width.
+#[inline(never)]
+fn gather<T: Le>(p: &mut Put<'_>, l: &Layout, occupancy: &[u64], plane: &[T], per: usize) {
+    if plane.is_empty() {
+        return;
+    }
+    each_cell(l, occupancy, &mut |cell| {
+        for k in 0..per {
+            plane[cell * per + k].put(p);
+        }
+    });
+}
+
+/// Writes a plane of an image of `per` values a particle, `from`, into the
+/// world's plane `to`: the particles' values in cell order, each where the
+/// occupancy plane `occupancy` of a world planned as `l` has it. A plane
+/// the image does not hold is empty there, and writes nothing. Out of
+/// line: one copy for every plane of a width.
+#[inline(never)]
+fn scatter<T: Le>(l: &Layout, occupancy: &[u64], from: &[u8], per: usize, to: &mut [T]) {
+    let mut from = from.chunks_exact(per * size_of::<T>());
+    each_cell(l, occupancy, &mut |cell| {
+        if let Some(values) = from.next() {
+            for (k, b) in values.chunks_exact(size_of::<T>()).enumerate() {
+                to[cell * per + k] = T::le(b);
+            }
+        }
+    });
 }
 
 /// Bytes of the image of a world described by `d`, planned as `l`, with
@@ -352,12 +432,17 @@ fn put_desc(p: &mut Put<'_>, d: &Description) {
 
 fn get_desc(g: &mut Get<'_>) -> Result<Description, Error> {
     let bad = invalid(c"desc (a value)");
+    // Taken whole, then read from the copy: every read below is at an
+    // offset known when compiled, so none needs a check of its own.
+    let fixed: [u8; DESC] = g.array()?;
+    let g = &mut Get { rest: &fixed };
     let dim = g.u32()?;
     let size = [g.u32()?, g.u32()?, g.u32()?];
     let seed = g.u64()?;
+    let faces: [u8; 6] = g.array()?;
     let mut boundary = [[Boundary::Periodic; 2]; 3];
-    for face in boundary.iter_mut().flatten() {
-        *face = match g.u8()? {
+    for (face, &b) in boundary.iter_mut().flatten().zip(&faces) {
+        *face = match b {
             0 => Boundary::Periodic,
             1 => Boundary::Wall,
             2 => Boundary::Open,
@@ -369,25 +454,26 @@ fn get_desc(g: &mut Get<'_>) -> Result<Description, Error> {
         16 => Quantization::Bits16,
         _ => return Err(bad),
     };
-    let drift = match g.u8()? {
-        0 => Drift::Paper,
-        1 => Drift::Calibrated,
-        _ => return Err(bad),
+    // The flags, and the enumerations of two values, are converted as
+    // read and checked together at the end: valid when none is above 1,
+    // that is when they or'ed together are at most 1 (as `mpca_desc`'s
+    // conversion in the C library checks its own).
+    let mut ones = 0;
+    let mut one = |v: u8| {
+        ones |= v;
+        v & 1 != 0
     };
+    let drift = if one(g.u8()?) { Drift::Calibrated } else { Drift::Paper };
     let method = match g.u8()? {
         0 => Method::Exhaustive,
         1 => Method::ExactFast,
         2 => Method::Greedy,
         _ => return Err(bad),
     };
-    let collisions = match g.u8()? {
-        0 => Collisions::Paper,
-        1 => Collisions::SpeedLimited,
-        _ => return Err(bad),
-    };
-    let (per_particle_mass, obstacles, lifetimes, contacts) = (g.flag()?, g.flag()?, g.flag()?, g.flag()?);
-    let forces = Forces { uniform: g.flag()?, field: g.flag()?, potential: g.flag()?, vortex: g.flag()? };
-    let (energy_neutral, flow) = (g.flag()?, g.flag()?);
+    let collisions = if one(g.u8()?) { Collisions::SpeedLimited } else { Collisions::Paper };
+    let flags: [u8; 10] = g.array()?;
+    let [per_particle_mass, obstacles, lifetimes, contacts, uniform, field, potential, vortex, energy_neutral, flow] = flags.map(&mut one);
+    let forces = Forces { uniform, field, potential, vortex };
     let mass = g.f32()?;
     // A capacity beyond 16 bits is ignored (masses off) or refused by the
     // description's check anyway: kept at the largest.
@@ -397,9 +483,12 @@ fn get_desc(g: &mut Get<'_>) -> Result<Description, Error> {
     let vortex = Vortex { centre: [g.f32()?, g.f32()?], core_radius: g.f32()?, circulation: g.f32()? };
     let (restitution, wall_restitution, dt) = (g.f32()?, g.f32()?, g.f32()?);
     let (rate, wind) = (g.f32()?, [g.f32()?, g.f32()?, g.f32()?]);
-    let drag = Drag { rate, wind, field: g.flag()?, vortex: flow };
+    let drag = Drag { rate, wind, field: one(g.u8()?), vortex: flow };
     let identity = Identity::from_bits(u32::from(g.u8()?)).ok_or(bad)?;
-    let rest = g.flag()?;
+    let rest = one(g.u8()?);
+    if ones > 1 {
+        return Err(invalid(c"desc (a flag)"));
+    }
     g.zeros(1)?;
     Ok(Description {
         dim,
@@ -441,6 +530,7 @@ fn put_surface(p: &mut Put<'_>, s: &Surface) {
 }
 
 fn get_surface(b: &[u8]) -> Surface {
+    let b = first::<SURFACE>(b);
     let f = |i| f32::from_bits(le_u32(b, i));
     Surface { cell: le_u32(b, 0), normal: [f(1), f(2), f(3)], restitution: f(4), from_mask: le_u32(b, 5) }
 }
@@ -560,6 +650,8 @@ fn read(image: &[u8]) -> Result<Image<'_>, Error> {
     // M13: version 3 is a world with bodies, and only such a world.
     let (mut crushed, mut redraws) = (0, 0);
     if version == 3 {
+        let head: [u8; BODY_HEAD] = g.array()?;
+        let g = &mut Get { rest: &head };
         (desc.body_capacity, desc.body_surface_capacity, crushed, redraws) = (g.u32()?, g.u32()?, g.u64()?, g.u32()?);
         g.zeros(4)?;
         if !desc.obstacles || desc.body_capacity == 0 {
@@ -575,17 +667,20 @@ fn read(image: &[u8]) -> Result<Image<'_>, Error> {
     if desc.dim == 2 && desc.size[2] != 1 {
         return Err(invalid(c"desc.size[2]"));
     }
-    let step = g.u64()?;
+    // Read from a copy, as the description is.
+    let state: [u8; STATE] = g.array()?;
+    let s = &mut Get { rest: &state };
+    let step = s.u64()?;
     let [particles, emitted, exited, expired, shortfall, collisions, clamps] =
-        [g.u64()?, g.u64()?, g.u64()?, g.u64()?, g.u64()?, g.u64()?, g.u64()?];
+        [s.u64()?, s.u64()?, s.u64()?, s.u64()?, s.u64()?, s.u64()?, s.u64()?];
     // 16 bytes in the image; the world counts in a u64.
-    let clamp_energy = u64::try_from(u128::from_le_bytes(g.array()?)).map_err(|_| invalid(c"clamp energy"))?;
-    let [displaced, processed, skipped] = [g.u64()?, g.u64()?, g.u64()?];
+    let clamp_energy = u64::try_from(u128::from_le_bytes(s.array()?)).map_err(|_| invalid(c"clamp energy"))?;
+    let [displaced, processed, skipped] = [s.u64()?, s.u64()?, s.u64()?];
     let counters =
         Counters { particles, emitted, exited, expired, shortfall, collisions, clamps, clamp_energy, displaced, processed, skipped };
-    let [masses, surfaces, emitters] = [g.u32()?, g.u32()?, g.u32()?].map(|c| c as usize);
+    let [masses, surfaces, emitters] = [s.u32()?, s.u32()?, s.u32()?].map(|c| c as usize);
     // What was a reserved zero word: a world without ids gives none.
-    let ids_given = g.u32()?;
+    let ids_given = s.u32()?;
     if !desc.identity.ids() && ids_given != 0 {
         return Err(invalid(c"ids given"));
     }
@@ -640,6 +735,13 @@ fn read(image: &[u8]) -> Result<Image<'_>, Error> {
     Ok(img)
 }
 
+/// Whether every value of an image's plane of `f32` is finite. Out of
+/// line: one copy for every plane.
+#[inline(never)]
+fn finite_plane(plane: &[u8]) -> bool {
+    plane.chunks_exact(4).all(|b| f32::from_bits(le_u32(b, 0)).is_finite())
+}
+
 /// The rules a live world keeps, held against an image's content.
 fn check(img: &Image<'_>) -> Result<(), Error> {
     let bad = |detail| Err(invalid(detail));
@@ -689,8 +791,7 @@ fn check(img: &Image<'_>) -> Result<(), Error> {
     // Force and wind planes: finite, as the set functions require, and no
     // cell's wind faster than 1.
     let float = |plane: &[u8], i: usize| f32::from_bits(le_u32(plane, i));
-    let floats = |plane: &[u8]| (0..plane.len() / 4).all(|i| float(plane, i).is_finite());
-    if !floats(img.field) || !floats(img.potential) || !floats(img.wind) {
+    if ![img.field, img.potential, img.wind].into_iter().all(finite_plane) {
         return bad(c"force, potential or wind planes");
     }
     let wind_cell = |i: usize| -> [f32; 3] { core::array::from_fn(|k| if k < dim { float(img.wind, i + k) } else { 0.0 }) };
@@ -849,40 +950,35 @@ fn apply(w: &mut World, img: &Image<'_>) {
             p.age.fill(0);
             p.tag.fill(0);
         }
-        // The skip summaries (M3), exact: flagged where a particle is.
+        // The skip summaries (M3), exact: flagged where a particle is,
+        // every word holding one.
         p.rows.fill(0);
         p.words.fill(0);
         let (rows, words) = (Cells::new(&mut *p.rows), Cells::new(&mut *p.words));
-        let (width, scale) = width_and_scale(d.quantization);
-        let mut i = 0;
-        each_bit(&l, |k| le_u64(img.occupancy, k), |row, x| {
-            mark(rows, words, l.summary_words, row, x);
-            let cell = x + l.n[0] * row;
-            for k in 0..dim {
-                store(p.velocity, cell * dim + k, width, component(&img.velocity[(i * dim + k) * width..], width).clamp(-scale, scale));
+        for (i, &word) in p.occupancy.iter().enumerate() {
+            if word != 0 {
+                mark(rows, words, l.summary_words, i / l.row_words, i % l.row_words * 64);
             }
-            if d.per_particle_mass {
-                p.mass_index[cell] = img.mass_index[i];
-            }
-            if d.lifetimes {
-                p.life[cell] = u16::from_le_bytes([img.life[2 * i], img.life[2 * i + 1]]);
-            }
-            // M6b: an image with these planes reads only where they are
-            // built (`read` refuses others).
-            #[cfg(feature = "identity")]
-            {
-                if d.identity.ids() {
-                    p.id[cell] = le_u32(img.id, i);
-                }
-                if d.identity.ages() {
-                    p.age[cell] = le_u32(img.age, i);
-                }
-                if d.identity.tags() {
-                    p.tag[cell] = img.tag[i];
-                }
-            }
-            i += 1;
-        });
+        }
+        // Plane by plane, the particles' values in cell order. The
+        // velocities as the image holds them: `check` refused any
+        // component beyond the width's scale.
+        let occupancy = &*p.occupancy;
+        if width_and_scale(d.quantization).0 == 1 {
+            scatter::<u8>(&l, occupancy, img.velocity, dim, p.velocity);
+        } else {
+            scatter::<u16>(&l, occupancy, img.velocity, dim, view(p.velocity));
+        }
+        scatter::<u8>(&l, occupancy, img.mass_index, 1, p.mass_index);
+        scatter::<u16>(&l, occupancy, img.life, 1, p.life);
+        // M6b: an image with these planes reads only where they are
+        // built (`read` refuses others).
+        #[cfg(feature = "identity")]
+        {
+            scatter::<u32>(&l, occupancy, img.id, 1, p.id);
+            scatter::<u32>(&l, occupancy, img.age, 1, p.age);
+            scatter::<u8>(&l, occupancy, img.tag, 1, p.tag);
+        }
         for (plane, bytes) in [(p.field, img.field), (p.potential, img.potential), (p.wind, img.wind)] {
             for (k, f) in plane.iter_mut().enumerate() {
                 *f = f32::from_bits(le_u32(bytes, k));
@@ -929,6 +1025,7 @@ fn put_body(p: &mut Put<'_>, b: &crate::rules::body::Body) {
 #[cfg(feature = "obstacles")]
 fn get_body(b: &[u8]) -> crate::rules::body::Body {
     use crate::rules::body::{Body, Tally};
+    let b = first::<BODY>(b);
     let f = |i| f32::from_bits(le_u32(b, i));
     let tally = |w: usize| Tally {
         momentum: [0, 1, 2].map(|k| le_u64(&b[4 * w..], k) as i64),
@@ -1016,6 +1113,8 @@ impl World {
     /// Bytes of the image [`World::save`] writes now: a fixed head and state,
     /// the occupancy and obstacle bit planes, a few bytes per particle,
     /// the force and wind planes, and the used entries of the tables (M12).
+    // Out of line: one copy for the writer and the C library's exports.
+    #[inline(never)]
     pub fn snapshot_bytes(&self) -> usize {
         let h = &self.head;
         let occupancy: &[u64] = self.plane(h.layout.occupancy());
@@ -1033,80 +1132,70 @@ impl World {
         let l = h.layout;
         let dim = self.dim();
         let mut p = Put { out, at: 0 };
-        p.bytes(&MAGIC);
         let bodies = body_bytes(&self.saved_desc()) > 0;
-        p.u32(if bodies { 3 } else { 2 });
-        p.u32(0);
-        p.u64(len as u64);
-        put_desc(&mut p, &h.desc);
+        p.fixed::<HEAD>(|p| {
+            p.bytes(&MAGIC);
+            p.u32(if bodies { 3 } else { 2 });
+            p.u32(0);
+            p.u64(len as u64);
+        });
+        p.fixed::<DESC>(|p| put_desc(p, &h.desc));
         #[cfg(feature = "obstacles")]
         if let Some((crushed, redraws)) = self.body_head() {
-            p.u32(h.desc.body_capacity);
-            p.u32(h.desc.body_surface_capacity);
-            p.u64(crushed);
-            p.u32(redraws);
-            p.u32(0);
+            p.fixed::<BODY_HEAD>(|p| {
+                p.u32(h.desc.body_capacity);
+                p.u32(h.desc.body_surface_capacity);
+                p.u64(crushed);
+                p.u32(redraws);
+                p.u32(0);
+            });
         }
-        p.u64(h.step);
-        let Counters { particles, emitted, exited, expired, shortfall, collisions, clamps, clamp_energy, displaced, processed, skipped } =
-            h.counters;
-        for c in [particles, emitted, exited, expired, shortfall, collisions, clamps] {
-            p.u64(c);
-        }
-        p.bytes(&u128::from(clamp_energy).to_le_bytes());
-        for c in [displaced, processed, skipped] {
-            p.u64(c);
-        }
-        for c in [h.masses, h.surfaces, h.emitters, h.ids_given] {
-            p.u32(c);
-        }
+        p.fixed::<STATE>(|p| {
+            p.u64(h.step);
+            let Counters { particles, emitted, exited, expired, shortfall, collisions, clamps, clamp_energy, displaced, processed, skipped } =
+                h.counters;
+            for c in [particles, emitted, exited, expired, shortfall, collisions, clamps] {
+                p.u64(c);
+            }
+            p.bytes(&u128::from(clamp_energy).to_le_bytes());
+            for c in [displaced, processed, skipped] {
+                p.u64(c);
+            }
+            for c in [h.masses, h.surfaces, h.emitters, h.ids_given] {
+                p.u32(c);
+            }
+        });
         let occupancy: &[u64] = self.plane(l.occupancy());
         occupancy.iter().for_each(|&w| p.u64(w));
         // The static obstacles: bodies are drawn again from their table
         // when the image is loaded (M13).
         let obstacle: &[u64] = self.plane(l.obstacle());
+        let body = self.body_cells();
         for (i, &w) in obstacle.iter().enumerate() {
-            p.u64(w & !self.body_word(i));
+            p.u64(w & !body.get(i).copied().unwrap_or(0));
         }
         // Per particle, in cell order: velocities, mass classes, lifetimes,
-        // then ids, ages and tags.
-        let each_particle = |f: &mut dyn FnMut(usize)| each_cell(&l, occupancy, f);
-        with_quant!(h.desc.quantization, Q => {
-            let v: &[Q] = self.plane(l.velocity());
-            each_particle(&mut |cell| {
-                for k in 0..dim {
-                    // The low byte of an i16 is the i8 itself.
-                    p.bytes(&(v[cell * dim + k].to_int() as i16).to_le_bytes()[..size_of::<Q>()]);
-                }
-            });
-        });
-        if h.desc.per_particle_mass {
-            let index: &[u8] = self.plane(l.mass_index());
-            each_particle(&mut |cell| p.u8(index[cell]));
+        // then ids, ages and tags. The velocities as stored: an 8-bit
+        // component is its byte, a 16-bit one its two.
+        if width_and_scale(h.desc.quantization).0 == 1 {
+            gather::<u8>(&mut p, &l, occupancy, self.plane(l.velocity()), dim);
+        } else {
+            gather::<u16>(&mut p, &l, occupancy, self.plane(l.velocity()), dim);
         }
-        if h.desc.lifetimes {
-            let life: &[u16] = self.plane(l.life());
-            each_particle(&mut |cell| p.bytes(&life[cell].to_le_bytes()));
-        }
+        gather::<u8>(&mut p, &l, occupancy, self.plane(l.mass_index()), 1);
+        gather::<u16>(&mut p, &l, occupancy, self.plane(l.life()), 1);
         // M6b: ids, ages, tags.
-        for plane in [l.id(), l.age()] {
-            let values: &[u32] = self.plane(plane);
-            if !values.is_empty() {
-                each_particle(&mut |cell| p.u32(values[cell]));
-            }
+        gather::<u32>(&mut p, &l, occupancy, self.plane(l.id()), 1);
+        gather::<u32>(&mut p, &l, occupancy, self.plane(l.age()), 1);
+        gather::<u8>(&mut p, &l, occupancy, self.plane(l.tag()), 1);
+        for plane in [l.field(), l.potential(), l.wind()] {
+            p.f32s(self.plane(plane));
         }
-        let tag: &[u8] = self.plane(l.tag());
-        if !tag.is_empty() {
-            each_particle(&mut |cell| p.u8(tag[cell]));
-        }
-        self.plane::<f32>(l.field()).iter().for_each(|&f| p.f32(f));
-        self.plane::<f32>(l.potential()).iter().for_each(|&u| p.f32(u));
-        self.plane::<f32>(l.wind()).iter().for_each(|&u| p.f32(u));
-        self.plane::<f32>(l.mass_table())[..h.masses as usize].iter().for_each(|&m| p.f32(m));
-        self.plane::<Surface>(l.surface())[..h.surfaces as usize].iter().for_each(|s| put_surface(&mut p, s));
-        self.plane::<Slot>(l.emitters())[..h.emitters as usize].iter().for_each(|s| put_slot(&mut p, s));
+        p.f32s(&self.plane::<f32>(l.mass_table())[..h.masses as usize]);
+        self.plane::<Surface>(l.surface())[..h.surfaces as usize].iter().for_each(|s| p.fixed::<SURFACE>(|p| put_surface(p, s)));
+        self.plane::<Slot>(l.emitters())[..h.emitters as usize].iter().for_each(|s| p.fixed::<EMITTER>(|p| put_slot(p, s)));
         #[cfg(feature = "obstacles")]
-        self.body_table().iter().for_each(|b| put_body(&mut p, b));
+        self.body_table().iter().for_each(|b| p.fixed::<BODY>(|p| put_body(p, b)));
         let crc = crc32(&p.out[..len - CHECKSUM]);
         p.u32(crc);
         debug_assert_eq!(p.at, len);

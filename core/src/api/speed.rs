@@ -14,7 +14,8 @@ use crate::rules::fixed::parts;
 /// Whether `u` (1 to 3 finite components, as every caller has checked)
 /// has `|u| <= 1`, exactly: integers decide ([`too_fast`] with no spread),
 /// after the `f32` sum of the squares where that is far enough from 1 to
-/// decide ([`far_from_one`]).
+/// decide ([`far_from_one`]). Out of line: one copy for every caller.
+#[inline(never)]
 pub(crate) fn slow(u: &[f32]) -> bool {
     let mut v = [0.0f32; 3];
     for (to, &c) in v.iter_mut().zip(u) {

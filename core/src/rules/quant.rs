@@ -57,23 +57,10 @@ pub(crate) trait Quant: Copy + Default + Send + crate::storage::plain::Plain + '
         self.to_int() as f32 * (1.0 / Self::SCALE)
     }
 
-    /// Round to nearest, halves away from zero so that `v` and `-v` store
-    /// opposite values: for velocities a caller sets, which need no stream.
-    #[inline]
-    fn nearest(v: f32) -> Self {
-        Self::from_int(libm::roundf(v.clamp(-1.0, 1.0) * Self::SCALE) as i32)
-    }
-
     /// Fine units a quantum (M1c's `F`): `2^FINE` of them make one.
     const FINE: u32;
     /// Fine units to a unit speed (M1c's `W`, `SCALE 2^FINE`).
     const UNIT: i32;
-
-    /// [`Width::stochastic`] for this type's width.
-    #[inline(always)]
-    fn stochastic(x: i32, r: u32) -> i32 {
-        Width::of::<Self>().stochastic(x, r)
-    }
 
     /// M5.3: the largest 16 random bits `r` that say "move" for a stored
     /// component `q` (in quanta, not 0; its sign ignored) under `drift`:
@@ -106,11 +93,26 @@ impl Width {
         Width { fine: Q::FINE, unit: Q::UNIT, low: (1 << Q::FINE) - 1, wide: core::mem::size_of::<Q>() > 1 }
     }
 
-    /// The width of a world of `quantization` (read by the pipeline with
-    /// every part, which `small-step` instantiates per width instead).
-    #[cfg(not(feature = "small-step"))]
+    /// The width of a world of `quantization`: read by the pipeline with
+    /// every part (which `small-step` instantiates per width instead) and
+    /// by edits, each of them one copy of its code for both widths.
     pub(crate) fn of_quantization(quantization: crate::api::desc::Quantization) -> Width {
         with_quant!(quantization, Q => Width::of::<Q>())
+    }
+
+    /// Stored steps per unit speed ([`Quant::SCALE`]).
+    #[inline(always)]
+    pub(crate) fn scale(self) -> i32 {
+        self.unit >> self.fine
+    }
+
+    /// `v` (clamped to `[-1, 1]`) in quanta, rounded to nearest, halves
+    /// away from zero so that `v` and `-v` store opposite values: for
+    /// velocities a caller sets, which need no stream.
+    #[inline(always)]
+    pub(crate) fn nearest(self, v: f32) -> i32 {
+        let scale = self.scale();
+        (libm::roundf(v.clamp(-1.0, 1.0) * scale as f32) as i32).clamp(-scale, scale)
     }
 
     /// 16-bit storage: never in a build without the feature `q16`, where
@@ -282,7 +284,7 @@ mod tests {
 
     fn mean_of<Q: Quant>(x: i32, n: u32) -> f64 {
         let mut rng = block_stream(3, 0, 0);
-        (0..n).map(|_| f64::from(Q::stochastic(x, rng.bits(16)))).sum::<f64>() / f64::from(n)
+        (0..n).map(|_| f64::from(Width::of::<Q>().stochastic(x, rng.bits(16)))).sum::<f64>() / f64::from(n)
     }
 
     /// `x` quanta in fine units of `Q`, to nearest.
@@ -304,7 +306,7 @@ mod tests {
                 let x = fine::<Q>(x);
                 let lo = x >> Q::FINE;
                 let phi = x - (lo << Q::FINE);
-                let ups = (0..1u32 << 16).step_by(stride).filter(|&r| Q::stochastic(x, r) == lo + 1).count();
+                let ups = (0..1u32 << 16).step_by(stride).filter(|&r| Width::of::<Q>().stochastic(x, r) == lo + 1).count();
                 let want = (phi as usize) << (16 - Q::FINE);
                 assert!((ups * stride).abs_diff(want) <= (stride - 1) << (16 - Q::FINE), "{x}: {ups}");
             }
@@ -331,19 +333,19 @@ mod tests {
     fn integers_in_quanta_stay_put() {
         for q in -127..=127 {
             for r in [0, 1, 0x7fff, 0xffff] {
-                assert_eq!(i8::stochastic(q << 16, r), q);
+                assert_eq!(Width::of::<i8>().stochastic(q << 16, r), q);
             }
         }
-        assert_eq!(i8::stochastic(i8::UNIT, 0xffff), 127);
-        assert_eq!(i8::stochastic(-i8::UNIT, 0xffff), -127);
+        assert_eq!(Width::of::<i8>().stochastic(i8::UNIT, 0xffff), 127);
+        assert_eq!(Width::of::<i8>().stochastic(-i8::UNIT, 0xffff), -127);
         #[cfg(feature = "q16")]
-        assert_eq!(i16::stochastic(-32767 << 12, 0), -32767);
+        assert_eq!(Width::of::<i16>().stochastic(-32767 << 12, 0), -32767);
     }
 
     #[test]
     fn nearest_round_trips_every_stored_value() {
         for q in -127..=127 {
-            assert_eq!(i8::nearest(i8::from_int(q).get()).to_int(), q);
+            assert_eq!(Width::of::<i8>().nearest(i8::from_int(q).get()), q);
         }
     }
 

@@ -311,8 +311,9 @@ impl Layout {
         let mut at = 0usize;
         for p in &mut plane {
             p.off = at;
-            at = at.checked_add(p.len).and_then(|e| e.checked_add(7)).ok_or(Error::new(ErrorKind::TooLarge, TOTAL))? & !7;
-            // Slices may not exceed isize::MAX bytes.
+            // Saturating: a sum past usize::MAX is past the bound below
+            // too. Slices may not exceed isize::MAX bytes.
+            at = at.saturating_add(p.len).saturating_add(7) & !7;
             if at > isize::MAX as usize / 2 {
                 return Err(Error::new(ErrorKind::TooLarge, TOTAL));
             }
@@ -463,7 +464,9 @@ pub(crate) struct Site {
 /// Writes stored component `i` of a velocity plane of `width`-byte
 /// components (1, or 2 in the target's byte order) viewed as bytes: `q`,
 /// in quanta, within the width's range. Callers that hold the plane as
-/// bytes have one copy of their code for both widths.
+/// bytes have one copy of their code for both widths: the bodies'
+/// push-out (M13), which a build without `obstacles` does not have.
+#[cfg(feature = "obstacles")]
 #[inline(always)]
 pub(crate) fn store(plane: &mut [u8], i: usize, width: usize, q: i32) {
     if width == 1 || !cfg!(feature = "q16") {

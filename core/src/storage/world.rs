@@ -391,15 +391,12 @@ impl World {
         0
     }
 
-    /// Word `i` of the plane of cells bodies cover (M13): 0 without bodies.
-    pub(crate) fn body_word(&self, i: usize) -> u64 {
+    /// The plane of cells bodies cover (M13): empty without bodies.
+    pub(crate) fn body_cells(&self) -> &[u64] {
         #[cfg(feature = "obstacles")]
-        return self.body_word_of(i);
+        return self.plane(self.layout().body_cells());
         #[cfg(not(feature = "obstacles"))]
-        {
-            let _ = i;
-            0
-        }
+        &[]
     }
 
     /// Whether cell `s` is a static obstacle (M7), not a body's (M13).
