@@ -6,7 +6,7 @@
 //! elastic 8-bit box. The figures are those the tests of
 //! `tests/tests/effects.rs` hold to their bounds, here with run times.
 
-use mpca::{Boundary, Collisions, World};
+use mpca::{Boundary, Collisions, Description, Error, World};
 
 use super::{memory, repeat, run_steps, Timing};
 use crate::scenes::{self, Scene};
@@ -175,6 +175,24 @@ pub fn measure(share: f64, box_steps: u64, runs: usize) -> Vec<AdditionRow> {
         (n, n),
     ));
 
+    // M5.7b on the pile: 8 rows under g = 0.02 (tests/tests/rest.rs).
+    for e in [0.0, 0.5] {
+        let (off, on) = (pile(e, false), pile(e, true));
+        let n = steps(off.steps);
+        out.extend(rows(
+            "M5.7b resting contact",
+            format!("{} (e = {e}, contacts)", off.name),
+            &[
+                ("mean speed at the end", |e| e.mean_speed),
+                ("share of occupied cells emptied in a step, at the end", |e| e.changing),
+                ("clamps per particle-step", |e| e.clamps_per_particle_step),
+            ],
+            run(&off, n, runs),
+            run(&on, n, runs),
+            (n, n),
+        ));
+    }
+
     // M1b: the elastic box, unbiased rounding against energy-neutral.
     out.extend(rows(
         "M1b energy-neutral rounding",
@@ -185,4 +203,29 @@ pub fn measure(share: f64, box_steps: u64, runs: usize) -> Vec<AdditionRow> {
         (box_steps, box_steps),
     ));
     out
+}
+
+/// The pile of tests/tests/rest.rs: a 64 x 48 box with walls, gravity 0.02
+/// down, restitution `e` for particles and walls, contacts on, resting
+/// contact as `rest` says, and 8 full rows dropped from 12 cells up;
+/// 1,500 steps.
+fn pile(e: f32, rest: bool) -> Scene {
+    let mut desc = Description::new_2d(64, 48).with_boundary(Boundary::Wall);
+    desc.forces.uniform = true;
+    desc.gravity = [0.0, -0.02, 0.0];
+    desc.restitution = e;
+    desc.wall_restitution = e;
+    desc.contacts = true;
+    desc.rest = rest;
+    desc.seed = 11;
+    Scene { name: "8-row pile, 64 × 48", section: "-", desc, steps: 1500, paper_seconds: f64::NAN, setup: fill_pile }
+}
+
+fn fill_pile(w: &mut World) -> Result<(), Error> {
+    for y in 12..20 {
+        for x in 0..64 {
+            w.add_particle([x, y, 0], [0.0; 3])?;
+        }
+    }
+    Ok(())
 }

@@ -756,7 +756,8 @@ fn additions(r: &Results) -> Table {
          steps, its vortex as a force) against the smoke with flow drag (its 1,200 steps); the e = 1 cluster with \
          the paper's collisions and with speed-limited ones; the poured water pool (e = 0.5) without and with \
          contacts, and with contacts without and with resting contact (M5.7b: the \"paper rule\" column is \
-         then M5.7 alone); an elastic 8-bit gas in a 128² box with walls (density 0.3, speed-limited collisions, so no \
+         then M5.7 alone), and 8 full rows dropped under gravity 0.02 in a 64 × 48 box, without and with \
+         resting contact (the pile of `tests/tests/rest.rs`); an elastic 8-bit gas in a 128² box with walls (density 0.3, speed-limited collisions, so no \
          clamp) with unbiased and with energy-neutral rounding. The figures the tests of `tests/tests/effects.rs` \
          hold to their bounds. One timed run each.",
         vec![
