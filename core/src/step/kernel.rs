@@ -266,8 +266,9 @@ impl<const D: usize, const CELLS: usize> Kernel<'_, D, CELLS> {
             return;
         }
         let mut changes = Changes::<CELLS>::new();
-        // M5.7b: what the block's particles rest on (nothing without it).
-        let support = if P::ALL { sh.rest } else { None };
+        // M5.7b: what the block's particles rest on (nothing without it;
+        // no code for it in a build without the collision rules).
+        let support = if P::ALL && cfg!(feature = "collision-rules") { sh.rest } else { None };
         let resting = support.map_or(Resting::NONE, |s| s.read(&*b, site.blocked));
         self.force::<W, P>(site, b, &mut changes, carried, resting.cells);
         if P::ALL {
