@@ -145,6 +145,14 @@ pub enum mpca_status {
     Unknown = 199,
 }
 
+/// The status of a core error, for Rust callers of this crate's rlib (the
+/// fuzzers compare the C door's statuses with the core's errors).
+impl From<Error> for mpca_status {
+    fn from(e: Error) -> Self {
+        Self::of_error(e)
+    }
+}
+
 impl mpca_status {
     /// The status of a core error: the one with its number, which every
     /// error has (checked below for each at compile time), so no error

@@ -113,7 +113,7 @@ pub fn scene(input: &mut Input<'_>) -> mpca_desc {
     d.mass = [1.0, 0.5, 2.0, 3.0][input.pick(4)];
     let parts = input.u16();
     d.per_particle_mass = u32::from(parts & 1 != 0);
-    d.mass_classes = 1 + input.pick(8) as u16;
+    d.mass_classes = 1 + input.pick(8) as u32;
     d.obstacles = u32::from(parts & 2 != 0);
     d.surface_capacity = input.pick(65) as u32;
     d.forces = u32::from(input.u8() & 15);
