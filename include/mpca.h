@@ -708,7 +708,10 @@ typedef struct mpca_desc {
    */
   uint32_t per_particle_mass;
   /**
-   * Capacity of the mass table, 1 to 256.
+   * Capacity of the mass table, 1 to 256; with per-particle masses off it
+   * is not used, but above 65,535 it is refused all the same
+   * (MPCA_STATUS_CAPACITY_RANGE), so a world reports the description it
+   * was given.
    */
   uint32_t mass_classes;
   /**

@@ -106,7 +106,10 @@ pub struct mpca_desc {
     pub mass: f32,
     /// 1: particles carry their own masses (a table of `mass_classes`).
     pub per_particle_mass: u32,
-    /// Capacity of the mass table, 1 to 256.
+    /// Capacity of the mass table, 1 to 256; with per-particle masses off it
+    /// is not used, but above 65,535 it is refused all the same
+    /// (MPCA_STATUS_CAPACITY_RANGE), so a world reports the description it
+    /// was given.
     pub mass_classes: u32,
     /// 1: the world has obstacles.
     pub obstacles: u32,
@@ -316,8 +319,9 @@ impl mpca_desc {
             }
         }
         d.mass = self.mass;
-        // Beyond 16 bits: refused by the check (masses on) or ignored.
-        d.mass_classes = self.mass_classes.min(u32::from(u16::MAX)) as u16;
+        // The core keeps 16 bits: a value beyond them would come back
+        // changed, so it is refused, masses on or off.
+        d.mass_classes = u16::try_from(self.mass_classes).map_err(|_| Refusal::new(mpca_status::CapacityRange, c"desc.mass_classes"))?;
         d.surface_capacity = self.surface_capacity;
         (d.body_capacity, d.body_surface_capacity) = (self.body_capacity, self.body_surface_capacity);
         d.forces = Forces {

@@ -504,6 +504,13 @@ static void description_cases(void) {
         REFUSED(MPCA_STATUS_BAD_ENUM, mpca_desc_preset(&d, 3, 2, 8, 8, 0));
         REFUSED(MPCA_STATUS_BAD_ENUM, mpca_desc_preset(&d, UINT32_MAX, 3, 8, 8, 8));
         CHECK(memcmp(&kept, &d, sizeof d) == 0);
+        /* A mass table beyond 16 bits is refused even with masses off:
+         * the world could not report it back. */
+        mpca_desc big = d;
+        big.per_particle_mass = 0;
+        big.mass_classes = 65536;
+        set_context("desc.mass_classes = 65536, masses off");
+        desc_refused(&big, MPCA_STATUS_CAPACITY_RANGE, "desc.mass_classes");
         for (uint32_t p = MPCA_PRESET_SMOKE; p <= MPCA_PRESET_SAND; p++) {
             mpca_desc preset;
             CHECK_OK(mpca_desc_preset(&preset, p, 3, 8, 8, 8));

@@ -475,9 +475,9 @@ fn get_desc(g: &mut Get<'_>) -> Result<Description, Error> {
     let [per_particle_mass, obstacles, lifetimes, contacts, uniform, field, potential, vortex, energy_neutral, flow] = flags.map(&mut one);
     let forces = Forces { uniform, field, potential, vortex };
     let mass = g.f32()?;
-    // A capacity beyond 16 bits is ignored (masses off) or refused by the
-    // description's check anyway: kept at the largest.
-    let mass_classes = g.u32()?.min(u32::from(u16::MAX)) as u16;
+    // The description keeps 16 bits (no world has more): an image with
+    // more is refused, not read back changed.
+    let mass_classes = u16::try_from(g.u32()?).map_err(|_| invalid(c"desc.mass_classes"))?;
     let (surface_capacity, emitter_capacity) = (g.u32()?, g.u32()?);
     let gravity = [g.f32()?, g.f32()?, g.f32()?];
     let vortex = Vortex { centre: [g.f32()?, g.f32()?], core_radius: g.f32()?, circulation: g.f32()? };
