@@ -217,9 +217,10 @@ pub struct Description {
     /// index per cell into a table of `mass_classes` distinct masses.
     pub per_particle_mass: bool,
     /// Capacity of the mass table, 1 to 256. Sixteen bits: the description
-    /// then fits the 128 bytes a step copies with inline moves, not a call
-    /// of `memcpy` on the world's memory (a C program's ThreadSanitizer
-    /// sees such calls, but not the handle's ordering of them).
+    /// then stays small enough for a step to copy with inline moves, not a
+    /// call of `memcpy` on the world's memory (a C program's
+    /// ThreadSanitizer sees such calls, but not the handle's ordering of
+    /// them).
     pub mass_classes: u16,
     /// Whether the world has obstacle cells (feature `obstacles`).
     pub obstacles: bool,
