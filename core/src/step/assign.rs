@@ -155,7 +155,7 @@ impl<const D: usize, const CELLS: usize> Kernel<'_, D, CELLS> {
             let c = occ.trailing_zeros() as usize;
             return IDENTITY ^ (want >> (D * c) & axes) << (4 * c);
         }
-        let method = self.shared.desc.assignment();
+        let method = self.shared.rules.assignment();
         if D == 2 && method == Method::ExactFast {
             // The key's digits: 1 for a blocked cell, 2 + m for a particle
             // that wants to cross the axes m, 0 for a free cell.

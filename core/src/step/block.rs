@@ -5,6 +5,10 @@
 //! see them.
 
 use crate::api::desc::Description;
+#[cfg(not(feature = "small-step"))]
+use crate::api::desc::{Boundary, Collisions, Drift, Identity};
+#[cfg(not(feature = "small-step"))]
+use crate::rules::assign::Method;
 use crate::rules::assign::{bits, Bits};
 use crate::rules::class::Class;
 use crate::rules::faces::Coords;
@@ -17,14 +21,102 @@ use crate::storage::cells::Cells;
 use crate::storage::layout::{groups, view};
 use crate::storage::world::Counters;
 
-/// The description as a step's blocks read it: with `small-step` where it
-/// lies in the world's header (no copy to set up: less flash, a load more
-/// for each field a block reads), otherwise a copy beside the other
-/// shared data, which the plain instantiations read without that load.
-#[cfg(feature = "small-step")]
-pub(crate) type StepDescription<'a> = &'a Description;
+/// What a step's blocks read of the description, copied beside the other
+/// shared data once a step: the few settings the block rule branches on,
+/// not the whole description, whose copy grows with every setting a world
+/// has (a large copy is a library call, which ThreadSanitizer sees apart
+/// from the registry's atomics that order it).
+///
+/// Each switch a feature builds out reads false here as it does in
+/// [`Description`]'s own accessor, so that such a build holds no code for
+/// the part.
+///
+/// With `small-step` the blocks read the description where it lies in the
+/// world's header instead ([`StepRules`]): no copy to set up, less flash.
 #[cfg(not(feature = "small-step"))]
-pub(crate) type StepDescription<'a> = Description;
+#[derive(Clone, Copy)]
+pub(crate) struct BlockRules {
+    pub boundary: [[Boundary; 2]; 3],
+    pub wall_restitution: f32,
+    pub drift: Drift,
+    pub lifetimes: bool,
+    masses: bool,
+    obstacles: bool,
+    contacts: bool,
+    energy_neutral: bool,
+    collisions: Collisions,
+    method: Method,
+    identity: Identity,
+}
+
+/// The description's settings as the blocks read them: [`BlockRules`], or
+/// with `small-step` the description itself, which has the same fields and
+/// accessors.
+#[cfg(feature = "small-step")]
+pub(crate) type StepRules<'a> = &'a Description;
+#[cfg(not(feature = "small-step"))]
+pub(crate) type StepRules<'a> = BlockRules;
+
+#[cfg(not(feature = "small-step"))]
+impl BlockRules {
+    pub(crate) fn of(d: &Description) -> BlockRules {
+        BlockRules {
+            boundary: d.boundary,
+            wall_restitution: d.wall_restitution,
+            drift: d.drift,
+            lifetimes: d.lifetimes,
+            masses: d.has_masses(),
+            obstacles: d.has_obstacles(),
+            contacts: d.has_contacts(),
+            energy_neutral: d.has_energy_neutral(),
+            collisions: d.collision_rule(),
+            method: d.assignment(),
+            identity: d.identity_planes(),
+        }
+    }
+
+    /// As [`Description::has_masses`].
+    #[inline(always)]
+    pub(crate) const fn has_masses(&self) -> bool {
+        cfg!(feature = "mass") && self.masses
+    }
+
+    /// As [`Description::has_obstacles`].
+    #[inline(always)]
+    pub(crate) const fn has_obstacles(&self) -> bool {
+        cfg!(feature = "obstacles") && self.obstacles
+    }
+
+    /// As [`Description::has_contacts`].
+    #[inline(always)]
+    pub(crate) const fn has_contacts(&self) -> bool {
+        cfg!(feature = "collision-rules") && self.contacts
+    }
+
+    /// As [`Description::has_energy_neutral`].
+    #[inline(always)]
+    pub(crate) const fn has_energy_neutral(&self) -> bool {
+        cfg!(feature = "collision-rules") && self.energy_neutral
+    }
+
+    /// As [`Description::collision_rule`].
+    #[inline(always)]
+    pub(crate) const fn collision_rule(&self) -> Collisions {
+        if cfg!(feature = "collision-rules") { self.collisions } else { Collisions::Paper }
+    }
+
+    /// As [`Description::assignment`].
+    #[inline(always)]
+    pub(crate) const fn assignment(&self) -> Method {
+        if cfg!(feature = "all-methods") { self.method } else { Method::ExactFast }
+    }
+
+    /// As [`Description::identity_planes`].
+    #[inline(always)]
+    pub(crate) const fn identity_planes(&self) -> Identity {
+        if cfg!(feature = "identity") { self.identity } else { Identity::NONE }
+    }
+}
 
 impl Shared<'_> {
     /// The class of mass index `i`: the first where the index names none
@@ -263,7 +355,7 @@ impl<const CELLS: usize> Carried<CELLS> {
 
 /// What every block of a step reads and none writes.
 pub(crate) struct Shared<'a> {
-    pub desc: StepDescription<'a>,
+    pub rules: StepRules<'a>,
     pub n: [usize; 3],
     pub part: Partition,
     /// The width of the world's stored velocities, which the pipeline with

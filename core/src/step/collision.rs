@@ -39,13 +39,13 @@ impl<const D: usize, const CELLS: usize> Kernel<'_, D, CELLS> {
         let masses = (!equal).then_some((ca.relative, cc.relative));
         let s = if equal { HALVES } else { shares(ca.relative, cc.relative) };
         let e = self.shared.restitution;
-        let (mut xa, mut xc) = match self.shared.desc.collision_rule() {
+        let (mut xa, mut xc) = match self.shared.rules.collision_rule() {
             Collisions::Paper => collide_pair::<D>(va, vc, s, e, turned::<D>(difference::<D>(va, vc), rng), masses),
             // Below the limit by sqrt(D) quanta, so that rounding (less than a
             // quantum per component) cannot store a speed above 1 either.
             Collisions::SpeedLimited => collide_limited(va, vc, s, e, speed_limit2::<D>(w.unit, w.fine), masses, rng, D),
         };
-        if self.shared.desc.has_energy_neutral() {
+        if self.shared.rules.has_energy_neutral() {
             (xa, xc) = energy_neutral(xa, xc, s, w.fine, masses);
         }
         clamp_counted::<D>(&mut xa, w.unit, &ca, &mut self.counters);

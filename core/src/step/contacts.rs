@@ -34,7 +34,7 @@ pub(crate) fn contacts<const D: usize, const CELLS: usize>(
     counters: &mut Counters,
 ) {
     // Folds to none in a build without masses.
-    let mass_index = if sh.desc.has_masses() { mass_index } else { None };
+    let mass_index = if sh.rules.has_masses() { mass_index } else { None };
     let equal = mass_index.is_none();
     let class = |c: usize| match mass_index {
         Some(m) => sh.class(m[c]),
@@ -61,7 +61,7 @@ pub(crate) fn contacts<const D: usize, const CELLS: usize>(
         let length = rsqrt(sq::<D>(d)) as i32;
         let t = r.map(|c| mulq(length, c, 30));
         let (mut ya, mut yh) = collide_pair::<D>(xa, xh, s, sh.restitution, t, masses);
-        if sh.desc.has_energy_neutral() {
+        if sh.rules.has_energy_neutral() {
             (ya, yh) = energy_neutral(ya, yh, s, fine, masses);
         }
         clamp_counted::<D>(&mut ya, unit, &ca, counters);

@@ -231,7 +231,7 @@ impl<const D: usize, const CELLS: usize> Kernel<'_, D, CELLS> {
         if !P::ALL {
             return Carried::none();
         }
-        let desc = &self.shared.desc;
+        let desc = &self.shared.rules;
         let mut carried = Carried::new(desc.has_masses(), desc.lifetimes);
         for c in cells_of(occ) {
             if carried.masses() {
@@ -310,7 +310,7 @@ impl<const D: usize, const CELLS: usize> Kernel<'_, D, CELLS> {
         let w = W::width(sh);
         let occ = b.occ();
         let targets = self.assign(occ, |c| stored_speed2(b.stored(c)), site.blocked, want, rng);
-        if P::CONTACTS && sh.desc.has_contacts() && want != 0 {
+        if P::CONTACTS && sh.rules.has_contacts() && want != 0 {
             let mut changes = Changes::<CELLS>::new();
             // A copy: a reference would keep `carried` in memory, and its
             // switches from folding.
@@ -323,7 +323,7 @@ impl<const D: usize, const CELLS: usize> Kernel<'_, D, CELLS> {
         // then, and the test takes flash.
         // M6b: a plain world has no ids, ages or tags (not read for its
         // blocks).
-        let on = if P::ALL { sh.desc.identity_planes() } else { Identity::NONE };
+        let on = if P::ALL { sh.rules.identity_planes() } else { Identity::NONE };
         if !cfg!(feature = "small-step") && (targets ^ IDENTITY) & FIELDS[usize::from(occ)] == 0 && b.dirty() == 0 && !carried.lifetimes && !on.ages() {
             return;
         }
@@ -411,12 +411,12 @@ impl<const D: usize, const CELLS: usize> Kernel<'_, D, CELLS> {
             outside |= low | if x_out & 2 != 0 { const { cells_at(0, 1, D) } } else { 0 };
         }
         for c in cells_of(outside & Self::EVERY_CELL) {
-            match resolve(sh.n, &sh.desc.boundary, site.at(c)) {
+            match resolve(sh.n, &sh.rules.boundary, site.at(c)) {
                 Beyond::Wall(_) => site.wall |= 1 << c,
                 _ => site.open |= 1 << c,
             }
         }
-        site.blocked = site.wall | if sh.desc.has_obstacles() { read_block::<CELLS>(sh.obstacle, row, xs) & !outside & Self::EVERY_CELL } else { 0 };
+        site.blocked = site.wall | if sh.rules.has_obstacles() { read_block::<CELLS>(sh.obstacle, row, xs) & !outside & Self::EVERY_CELL } else { 0 };
         site
     }
 
@@ -462,7 +462,7 @@ impl<'a, Q: Typed, const D: usize, const CELLS: usize> BlockSink<'a> for Sink<'a
             sh.plain && (D == 2 || Q::LANES)
         };
         let lean = lean && row.outside == 0;
-        RowPlan { lean_below: if lean { sh.n[0] - 1 } else { 0 }, obstacles: sh.desc.has_obstacles() }
+        RowPlan { lean_below: if lean { sh.n[0] - 1 } else { 0 }, obstacles: sh.rules.has_obstacles() }
     }
 
     #[inline(always)]

@@ -37,6 +37,8 @@ use crate::rules::rng::StepKey;
 use crate::rules::class::Class;
 #[cfg(feature = "identity")]
 use crate::step::block::Identified;
+#[cfg(not(feature = "small-step"))]
+use crate::step::block::BlockRules;
 use crate::step::block::{Shared, Typed, Velocity, Writable};
 use crate::step::block::Kernel;
 use crate::step::rest::Support;
@@ -237,13 +239,6 @@ impl World {
         // Read by the potential's gradient alone, which only `fields` has.
         let periodic = if cfg!(feature = "fields") { self.periodic() } else { [false; 3] };
         let dim = self.dim();
-        // Without `small-step` the blocks read a copy of the description
-        // (`StepDescription`), taken here, before the header is borrowed:
-        // a copy made through the borrow would be a `memmove` (the
-        // compiler cannot tell that the two do not overlap), a large routine
-        // on a small core.
-        #[cfg(not(feature = "small-step"))]
-        let copy = self.head.desc;
         let (head, p) = self.planes::<u8>();
         // The description and the counters, borrowed from the header
         // together.
@@ -297,9 +292,9 @@ impl World {
         let plain = lean && !desc.has_rest() && !desc.has_masses() && !desc.lifetimes && !desc.identity_planes().any() && !summed && small_push;
         let shared = Shared {
             #[cfg(feature = "small-step")]
-            desc,
+            rules: desc,
             #[cfg(not(feature = "small-step"))]
-            desc: copy,
+            rules: BlockRules::of(desc),
             n,
             part,
             #[cfg(not(feature = "small-step"))]

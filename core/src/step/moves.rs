@@ -71,9 +71,9 @@ impl<const D: usize, const CELLS: usize> Kernel<'_, D, CELLS> {
         #[cfg(not(feature = "small-step"))]
         if !w.wide() {
             let top = u32::from(sh.tops[usize::from(q as u8)]);
-            return high < top || high == top && rng.bits(8) <= w.move_limit(sh.moves, sh.desc.drift, q) & 0xff;
+            return high < top || high == top && rng.bits(8) <= w.move_limit(sh.moves, sh.rules.drift, q) & 0xff;
         }
-        let limit = w.move_limit(sh.moves, sh.desc.drift, q);
+        let limit = w.move_limit(sh.moves, sh.rules.drift, q);
         let top = limit >> 8;
         high < top || high == top && rng.bits(8) <= limit & 0xff
     }
@@ -85,7 +85,7 @@ impl<const D: usize, const CELLS: usize> Kernel<'_, D, CELLS> {
         if inward == 0 {
             return 0;
         }
-        let (table, drift, w) = (self.shared.moves, self.shared.desc.drift, W::width(self.shared));
+        let (table, drift, w) = (self.shared.moves, self.shared.rules.drift, W::width(self.shared));
         let r = u64::from(rng.bits(32)) | u64::from(rng.bits(16)) << 32;
         let mut m = 0u8;
         for k in 0..D {

@@ -79,8 +79,8 @@ pub(crate) fn reflect_off(sh: &Shared<'_>, mut x: [i32; 3], c: usize, to: Wanted
     let (site, at) = (to.site.cell(t), to.site.at(t));
     let mut surface = None;
     if to.site.wall >> t & 1 != 0 {
-        if let Beyond::Wall(n) = resolve(sh.n, &sh.desc.boundary, at) {
-            surface = Some((axis_q30(n), sh.desc.wall_restitution));
+        if let Beyond::Wall(n) = resolve(sh.n, &sh.rules.boundary, at) {
+            surface = Some((axis_q30(n), sh.rules.wall_restitution));
         }
     }
     // A build without obstacles has no surface entry and no obstacle
@@ -107,12 +107,12 @@ pub(crate) fn reflect_off(sh: &Shared<'_>, mut x: [i32; 3], c: usize, to: Wanted
         // Unreachable for obstacles added through the API (every cell
         // next to a free one has an entry): the direction back to the
         // particle.
-        None if cfg!(feature = "obstacles") => (back_normal::<WIDEST>(c, t), sh.desc.wall_restitution),
+        None if cfg!(feature = "obstacles") => (back_normal::<WIDEST>(c, t), sh.rules.wall_restitution),
         // Unreachable without obstacles: only cells beyond a wall are
         // blocked then, and `resolve` gave their surface above. A normal
         // of 0 would reflect nothing; the build holds no code for the
         // direction back.
-        None => ([0; 3], sh.desc.wall_restitution),
+        None => ([0; 3], sh.rules.wall_restitution),
     };
     // Without obstacles only cells beyond a wall face are blocked, and a
     // particle asks for one only moving towards it (M5.3: every axis it
@@ -136,7 +136,7 @@ pub(crate) fn reflect_off(sh: &Shared<'_>, mut x: [i32; 3], c: usize, to: Wanted
             *a += ((c >> k) & 1) as isize - ((t >> k) & 1) as isize;
         }
         let back = back_normal::<WIDEST>(c, t);
-        if dot_q30(n, back) > 0 && axis_move_free(if cfg!(feature = "obstacles") { sh.obstacle } else { &[] }, sh.n, &sh.desc.boundary, at, x, dim) {
+        if dot_q30(n, back) > 0 && axis_move_free(if cfg!(feature = "obstacles") { sh.obstacle } else { &[] }, sh.n, &sh.rules.boundary, at, x, dim) {
             return None;
         }
         back
