@@ -110,7 +110,9 @@ static void draw_nozzle(const mpca_emitter *e, int below) {
  * cells per step^2 up, and a drag of 0.033 a step towards the air (M5.1b)
  * brings it to its terminal rise of 0.0069 / 0.033 = 0.21 cells a step
  * (0.25 m/s) in about half a second, so it never runs at the speed cap as
- * the paper's smoke does; the air drifts right at 0.04 cells a step (5
+ * the paper's smoke does; the preset's turbulence (M5.1c: eddies of 16
+ * cells, up to 0.5 cells a step, a new flow every 50 steps) makes the
+ * column waver and break up; the air drifts right at 0.04 cells a step (5
  * cm/s), which leans the plume as a draught in a room does. Speed-limited collisions (M5.2b) spread the
  * plume without speeding it up. It lives 4 s (lifetimes on); ids and
  * ages let the renderer follow each puff and fade it. Open at the top and

@@ -310,7 +310,8 @@ enum mpca_status
    */
   MPCA_STATUS_IMAGE_MISMATCH = 138,
   /**
-   * A flow drag rate is negative (M5.1b).
+   * A flow drag setting is out of range: a negative rate (M5.1b), or
+   * turbulence (M5.1c).
    */
   MPCA_STATUS_BAD_DRAG = 140,
   /**
@@ -837,11 +838,21 @@ typedef struct mpca_desc {
    */
   uint32_t rest;
   /**
-   * Must be zero. It keeps the structure free of padding, whose bytes a
-   * copy need not keep, so that descriptions compare byte for byte; the
-   * next field takes its place.
+   * Turbulence in the flow (M5.1c): the largest any component of the
+   * turbulent flow gets, in cells per step, 0 to 1; 0 is off. It acts
+   * through drag (`drag_rate` above 0).
    */
-  uint32_t reserved;
+  float drag_turbulence_amplitude;
+  /**
+   * The size of the turbulence's eddies in cells: a power of two from 1
+   * to 1024, dividing the size of every periodic axis.
+   */
+  uint32_t drag_turbulence_scale;
+  /**
+   * How fast the turbulence changes, per step, 0 to 1: a new random flow
+   * every 1 / rate steps, blended smoothly; 0 is a steady flow.
+   */
+  float drag_turbulence_rate;
 } mpca_desc;
 
 /**

@@ -20,7 +20,7 @@ mod storage;
 pub use rules::{assign, rng};
 pub use api::port;
 pub use assign::Method;
-pub use api::desc::{Boundary, Collisions, Description, Drag, Drift, Forces, Identity, Preset, Quantization, Vortex};
+pub use api::desc::{Boundary, Collisions, Description, Drag, Drift, Forces, Identity, Preset, Quantization, Turbulence, Vortex};
 pub use api::error::{Error, ErrorKind};
 #[cfg(feature = "alloc")]
 pub use api::owned::WorldBox;

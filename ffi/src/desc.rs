@@ -1,6 +1,6 @@
 //! `mpca_desc`: the scene description (M9), as C sees it.
 
-use mpca_core::{Boundary, Collisions, Description, Drag, Drift, Forces, Identity, Method, Preset, Quantization, Vortex};
+use mpca_core::{Boundary, Collisions, Description, Drag, Drift, Forces, Identity, Method, Preset, Quantization, Turbulence, Vortex};
 
 use core::ffi::CStr;
 
@@ -181,10 +181,16 @@ pub struct mpca_desc {
     /// uniform force and takes no push from it (M5.7b), so a pool or a pile
     /// comes to rest exactly. 0: the paper's rules.
     pub rest: u32,
-    /// Must be zero. It keeps the structure free of padding, whose bytes a
-    /// copy need not keep, so that descriptions compare byte for byte; the
-    /// next field takes its place.
-    pub reserved: u32,
+    /// Turbulence in the flow (M5.1c): the largest any component of the
+    /// turbulent flow gets, in cells per step, 0 to 1; 0 is off. It acts
+    /// through drag (`drag_rate` above 0).
+    pub drag_turbulence_amplitude: f32,
+    /// The size of the turbulence's eddies in cells: a power of two from 1
+    /// to 1024, dividing the size of every periodic axis.
+    pub drag_turbulence_scale: u32,
+    /// How fast the turbulence changes, per step, 0 to 1: a new random flow
+    /// every 1 / rate steps, blended smoothly; 0 is a steady flow.
+    pub drag_turbulence_rate: f32,
 }
 
 /// Description::new_2d's defaults as C sees them (the sizes aside), built
@@ -269,7 +275,9 @@ impl mpca_desc {
             body_capacity: d.body_capacity,
             body_surface_capacity: d.body_surface_capacity,
             rest: d.rest as u32,
-            reserved: 0,
+            drag_turbulence_amplitude: d.drag.turbulence.amplitude,
+            drag_turbulence_scale: d.drag.turbulence.scale,
+            drag_turbulence_rate: d.drag.turbulence.rate,
         }
     }
 
@@ -303,9 +311,10 @@ impl mpca_desc {
         d.contacts = one(self.contacts);
         d.rest = one(self.rest);
         d.energy_neutral = one(self.energy_neutral);
-        d.drag = Drag { rate: self.drag_rate, wind: self.drag_wind, field: one(self.drag_wind_field), vortex: one(self.drag_vortex) };
+        let turbulence = Turbulence { amplitude: self.drag_turbulence_amplitude, scale: self.drag_turbulence_scale, rate: self.drag_turbulence_rate };
+        d.drag = Drag { rate: self.drag_rate, wind: self.drag_wind, field: one(self.drag_wind_field), vortex: one(self.drag_vortex), turbulence };
         d.lifetimes = one(self.lifetimes);
-        if ones > 1 || self.forces & !FORCE_BITS != 0 || self.identity > Identity::ALL.bits() || self.reserved != 0 {
+        if ones > 1 || self.forces & !FORCE_BITS != 0 || self.identity > Identity::ALL.bits() {
             return Err(Refusal::computed(mpca_status::BadEnum, || self.bad_flag()));
         }
         // The core's flags are the C ABI's bits (checked at the top).
@@ -377,8 +386,6 @@ impl mpca_desc {
             c"desc.lifetimes"
         } else if self.forces & !FORCE_BITS != 0 {
             c"desc.forces"
-        } else if self.reserved != 0 {
-            c"desc.reserved"
         } else {
             c"desc.identity"
         }

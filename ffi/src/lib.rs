@@ -107,7 +107,7 @@ pub extern "C" fn mpca_version() -> *const core::ffi::c_char {
 // The layout C sees, fixed: the C tests assert the same with _Static_assert.
 const _: () = {
     use core::mem::{align_of, size_of};
-    assert!(size_of::<mpca_desc>() == 192 && align_of::<mpca_desc>() == 8);
+    assert!(size_of::<mpca_desc>() == 200 && align_of::<mpca_desc>() == 8);
     assert!(size_of::<mpca_stats>() == 152 && align_of::<mpca_stats>() == 8);
     assert!(size_of::<mpca_body_stats>() == 40 && align_of::<mpca_body_stats>() == 8);
     assert!(size_of::<mpca_region_stats>() == 48 && align_of::<mpca_region_stats>() == 8);

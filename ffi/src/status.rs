@@ -132,7 +132,8 @@ pub enum mpca_status {
     /// The image holds a world of another size or plan of memory than the
     /// world it is loaded into.
     ImageMismatch = 138,
-    /// A flow drag rate is negative (M5.1b).
+    /// A flow drag setting is out of range: a negative rate (M5.1b), or
+    /// turbulence (M5.1c).
     BadDrag = 140,
     /// Every particle id of the world's life was given: no particle can be
     /// added, and emitters count what they ask for as shortfall (M6b).

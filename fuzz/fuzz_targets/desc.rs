@@ -1,4 +1,4 @@
-//! Description validation, by both doors: the input's first 176 bytes as a
+//! Description validation, by both doors: the input's first bytes as a
 //! C `mpca_desc` (any field any value), and the same bytes read into the
 //! core's `Description`, each field brought near its range so validation
 //! runs deep. Checked: nothing panics; the C door refuses exactly what the
@@ -57,6 +57,13 @@ fn core_desc(c: &mpca_desc) -> Description {
     d.drag.wind = c.drag_wind;
     d.drag.vortex = c.drag_vortex & 1 == 1;
     d.drag.field = c.drag_wind_field & 1 == 1;
+    // Now and then a power of two, so that turbulence passes its checks.
+    let scale = c.drag_turbulence_scale;
+    d.drag.turbulence = mpca::Turbulence {
+        amplitude: c.drag_turbulence_amplitude,
+        scale: if scale & 3 == 0 { 1 << (scale >> 2) % 12 } else { scale },
+        rate: c.drag_turbulence_rate,
+    };
     d
 }
 
@@ -96,6 +103,9 @@ fn to_c(d: &Description) -> mpca_desc {
     c.drag_wind = d.drag.wind;
     c.drag_vortex = u32::from(d.drag.vortex);
     c.drag_wind_field = u32::from(d.drag.field);
+    c.drag_turbulence_amplitude = d.drag.turbulence.amplitude;
+    c.drag_turbulence_scale = d.drag.turbulence.scale;
+    c.drag_turbulence_rate = d.drag.turbulence.rate;
     c
 }
 

@@ -183,13 +183,14 @@ pub fn unsupported(d: &Description) -> Option<&'static str> {
 /// What [`unsupported`] names, and the detail of the refusal: the field
 /// that asks for it.
 fn refusal(d: &Description) -> Option<(&'static CStr, &'static str)> {
-    let checks: [(bool, &'static CStr, &'static str); 3] = [
+    let checks: [(bool, &'static CStr, &'static str); 4] = [
         // Correct where loops are not limited, but a dense 3D block's search
         // (8! leaves) runs past the loop limit of Mesa's lavapipe, which
         // ends a shader's loops after 65,535 iterations in all: untested.
         (d.dim == 2 || d.method != Method::Exhaustive, c"desc.method: exhaustive assignment in 3D", "exhaustive assignment in 3D"),
         (!(d.obstacles && d.body_capacity > 0), c"desc.body_capacity: bodies, obstacles the caller moves (M13)", "bodies, obstacles the caller moves (M13)"),
         (!d.rest, c"desc.rest: resting contact (M5.7b)", "resting contact (M5.7b)"),
+        (!(d.drag.rate > 0.0 && d.drag.turbulence.amplitude > 0.0), c"desc.drag.turbulence: turbulence (M5.1c)", "turbulence (M5.1c)"),
     ];
     checks.iter().find(|(ok, ..)| !ok).map(|&(_, detail, part)| (detail, part))
 }

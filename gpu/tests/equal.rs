@@ -144,6 +144,15 @@ fn a_part_the_backend_does_not_run_is_refused() {
     let w = WorldBox::new(&d).unwrap();
     assert_eq!(refused(&w), Some((mpca::ErrorKind::FeatureDisabled, "desc.body_capacity: bodies, obstacles the caller moves (M13)")));
     assert_eq!(mpca_gpu::unsupported(w.description()), Some("bodies, obstacles the caller moves (M13)"));
+    let mut d = Description::new_2d(16, 16);
+    d.rest = true;
+    let w = WorldBox::new(&d).unwrap();
+    assert_eq!(refused(&w), Some((mpca::ErrorKind::FeatureDisabled, "desc.rest: resting contact (M5.7b)")));
+    let mut d = Description::new_2d(16, 16);
+    d.drag = mpca::Drag { rate: 0.1, turbulence: mpca::Turbulence { amplitude: 0.2, scale: 8, rate: 0.05 }, ..mpca::Drag::OFF };
+    let w = WorldBox::new(&d).unwrap();
+    assert_eq!(refused(&w), Some((mpca::ErrorKind::FeatureDisabled, "desc.drag.turbulence: turbulence (M5.1c)")));
+    assert_eq!(mpca_gpu::unsupported(w.description()), Some("turbulence (M5.1c)"));
 }
 
 #[test]
@@ -517,7 +526,7 @@ fn force_fields_potentials_and_drag_step_as_on_the_cpu() {
             d.forces.potential = true;
             d.forces.vortex = true;
             d.vortex = mpca::Vortex { centre: [17.0, 10.5], core_radius: 4.0, circulation: 3.0 };
-            d.drag = mpca::Drag { rate: 0.2, wind: [0.1, -0.05, 0.0], field: true, vortex: true };
+            d.drag = mpca::Drag { rate: 0.2, wind: [0.1, -0.05, 0.0], field: true, vortex: true, ..mpca::Drag::OFF };
             d.mass = 1.7;
         });
         let mut rng = mpca::rng::block_stream(82, 0, 0);
@@ -768,7 +777,7 @@ fn forces_masses_and_collision_rules_step_as_on_the_cpu_in_3d() {
                 d.forces = mpca::Forces { uniform: true, field: true, potential: true, vortex: true };
                 d.gravity = [0.0, 0.004, -0.002];
                 d.vortex = mpca::Vortex { centre: [9.0, 5.5], core_radius: 3.0, circulation: 2.5 };
-                d.drag = mpca::Drag { rate: 0.2, wind: [0.1, -0.05, 0.07], field: true, vortex: true };
+                d.drag = mpca::Drag { rate: 0.2, wind: [0.1, -0.05, 0.07], field: true, vortex: true, ..mpca::Drag::OFF };
                 d.per_particle_mass = true;
                 d.mass_classes = 8;
                 d.collisions = mpca::Collisions::SpeedLimited;

@@ -19,7 +19,7 @@
 #include "check.h"
 
 /* The layout ffi/src/lib.rs asserts on the Rust side. */
-STATIC_ASSERT(sizeof(mpca_desc) == 192 && ALIGNOF(mpca_desc) == 8, "mpca_desc layout");
+STATIC_ASSERT(sizeof(mpca_desc) == 200 && ALIGNOF(mpca_desc) == 8, "mpca_desc layout");
 STATIC_ASSERT(sizeof(mpca_stats) == 152 && ALIGNOF(mpca_stats) == 8, "mpca_stats layout");
 STATIC_ASSERT(sizeof(mpca_body_stats) == 40 && ALIGNOF(mpca_body_stats) == 8, "mpca_body_stats layout");
 STATIC_ASSERT(sizeof(mpca_particle) == 44 && ALIGNOF(mpca_particle) == 4, "mpca_particle layout");
@@ -202,8 +202,9 @@ static unsigned char *align64(unsigned char *p) {
     return p + ((64 - (uintptr_t)p % 64) % 64);
 }
 
-/* Every part enabled: walls, obstacles, all four forces, per-particle
- * masses (a table of two), lifetimes, room for two emitters. */
+/* Every part enabled: walls, obstacles, all four forces, drag with the wind
+ * plane and turbulence, per-particle masses (a table of two), lifetimes,
+ * identity, room for two emitters. */
 static mpca_desc full_desc(uint32_t dim, uint32_t n) {
     mpca_desc d;
     CHECK_OK(mpca_desc_defaults(&d, dim, n, n, n));
@@ -224,6 +225,9 @@ static mpca_desc full_desc(uint32_t dim, uint32_t n) {
     d.emitter_capacity = 2;
     d.drag_rate = 0.1f;
     d.drag_wind_field = 1;
+    d.drag_turbulence_amplitude = 0.2f;
+    d.drag_turbulence_scale = 4;
+    d.drag_turbulence_rate = 0.05f;
     d.identity = MPCA_IDENTITY_IDS | MPCA_IDENTITY_AGES | MPCA_IDENTITY_TAGS;
     return d;
 }
@@ -452,7 +456,6 @@ static void description_cases(void) {
         DESC_VALUES(base, collisions, MPCA_STATUS_BAD_ENUM, "desc.collisions", 2, UINT32_MAX);
         DESC_VALUES(base, contacts, MPCA_STATUS_BAD_ENUM, "desc.contacts", 2, UINT32_MAX);
         DESC_VALUES(base, rest, MPCA_STATUS_BAD_ENUM, "desc.rest", 2, UINT32_MAX);
-        DESC_VALUES(base, reserved, MPCA_STATUS_BAD_ENUM, "desc.reserved", 1, UINT32_MAX);
         DESC_VALUES(base, energy_neutral, MPCA_STATUS_BAD_ENUM, "desc.energy_neutral", 2, UINT32_MAX);
         DESC_VALUES(base, drag_vortex, MPCA_STATUS_BAD_ENUM, "desc.drag_vortex", 2, UINT32_MAX);
         DESC_VALUES(base, drag_wind_field, MPCA_STATUS_BAD_ENUM, "desc.drag_wind_field", 2, UINT32_MAX);
@@ -481,6 +484,22 @@ static void description_cases(void) {
         DESC_FLOATS(base, vortex_core_radius, MPCA_STATUS_BAD_VORTEX, "desc.vortex.core_radius", 0.0f, -2.0f);
         DESC_FLOATS(base, drag_rate, MPCA_STATUS_NOT_FINITE, "desc.drag.rate", NAN, INFINITY, -INFINITY);
         DESC_FLOATS(base, drag_rate, MPCA_STATUS_BAD_DRAG, "desc.drag.rate", -1.0f, -1e-30f);
+        DESC_FLOATS(base, drag_turbulence_amplitude, MPCA_STATUS_NOT_FINITE, "desc.drag.turbulence", NAN, INFINITY, -INFINITY);
+        DESC_FLOATS(base, drag_turbulence_rate, MPCA_STATUS_NOT_FINITE, "desc.drag.turbulence", NAN, INFINITY);
+        DESC_FLOATS(base, drag_turbulence_amplitude, MPCA_STATUS_BAD_DRAG, "desc.drag.turbulence.amplitude (0 to 1)", -0.5f, -1e-30f,
+                    1.0001f, 2.0f);
+        DESC_FLOATS(base, drag_turbulence_rate, MPCA_STATUS_BAD_DRAG, "desc.drag.turbulence.rate (0 to 1)", -0.1f, 1.5f);
+        DESC_VALUES(base, drag_turbulence_scale, MPCA_STATUS_BAD_DRAG, "desc.drag.turbulence.scale (a power of two, 1 to 1024)", 0,
+                    3, 12, 2048, UINT32_MAX);
+        DESC_FLOATS(base, drag_rate, MPCA_STATUS_BAD_DRAG, "desc.drag.turbulence (needs desc.drag.rate above 0)", 0.0f);
+        {
+            /* A periodic first axis: the scale must divide its size. */
+            mpca_desc periodic = base;
+            periodic.boundary[0][0] = periodic.boundary[0][1] = MPCA_BOUNDARY_PERIODIC;
+            CHECK_OK(mpca_desc_validate(&periodic));
+            DESC_VALUES(periodic, drag_turbulence_scale, MPCA_STATUS_BAD_DRAG,
+                        "desc.drag.turbulence.scale (must divide the size of every periodic axis)", 2 * base.size[0], 1024);
+        }
         DESC_FLOATS(base, drag_wind[0], MPCA_STATUS_NOT_FINITE, "desc.drag.wind", NAN, INFINITY);
         DESC_FLOATS(base, drag_wind[1], MPCA_STATUS_SPEED_RANGE, "desc.drag.wind", 1.0001f, -2.0f);
     }

@@ -130,7 +130,7 @@ pub fn smoke_flow() -> Scene {
     desc.forces.uniform = true;
     desc.gravity = [0.0, 0.004, 0.0];
     desc.vortex = Vortex { centre: [64.0, 72.0], core_radius: 10.0, circulation: 12.0 };
-    desc.drag = mpca::Drag { rate: 0.05, wind: [0.0; 3], field: true, vortex: true };
+    desc.drag = mpca::Drag { rate: 0.05, wind: [0.0; 3], field: true, vortex: true, ..mpca::Drag::OFF };
     desc.emitter_capacity = 1;
     desc.seed = 43;
     Scene { name: "smoke-flow", section: "4.3b", desc, steps: 1200, paper_seconds: f64::NAN, setup: fill_smoke_flow }
@@ -180,6 +180,27 @@ fn fill_smoke(w: &mut World) -> Result<(), Error> {
 /// (0, 0.6) with a spread of 0.2.
 fn smoke_emitter(w: &mut World, min: [u32; 3], max: [u32; 3]) -> Result<(), Error> {
     w.add_emitter(Emitter { min, max, rate: 1.0, velocity: [0.0, 0.6, 0.0], spread: 0.2, mass: 1.0, lifetime: 0 })?;
+    Ok(())
+}
+
+/// A rising plume for M5.1c: the smoke preset (docs/model.md, Presets) in
+/// a 128 x 128 world with no wind, a vent 8 cells wide in the middle of
+/// the floor puffing one particle a step upwards, with the preset's
+/// turbulence or without it (drag alone: a column rising at the terminal
+/// speed). 1,200 steps; the smoke reaches the top after about 600.
+pub fn plume(turbulent: bool, seed: u64) -> Scene {
+    let mut desc = Description::preset(mpca::Preset::Smoke, 2, [128, 128, 1]);
+    if !turbulent {
+        desc.drag.turbulence = mpca::Turbulence::OFF;
+    }
+    desc.emitter_capacity = 1;
+    desc.seed = seed;
+    let name = if turbulent { "plume, turbulent" } else { "plume, drag alone" };
+    Scene { name, section: "M5.1c", desc, steps: 1200, paper_seconds: f64::NAN, setup: fill_plume }
+}
+
+fn fill_plume(w: &mut World) -> Result<(), Error> {
+    w.add_emitter(Emitter { min: [60, 0, 0], max: [68, 2, 1], rate: 1.0, velocity: [0.0, 0.2, 0.0], spread: 0.1, mass: 1.0, lifetime: 0 })?;
     Ok(())
 }
 

@@ -53,7 +53,9 @@ fn description(dim: u32, faces: Faces, variant: usize) -> Description {
     desc.contacts = variant % 4 < 2;
     desc.energy_neutral = variant % 3 == 1;
     if variant % 2 == 0 {
-        desc.drag = Drag { rate: 0.2, wind: [0.05, 0.1, -0.05], field: variant % 4 == 0, vortex: dim == 2 };
+        // Turbulence (M5.1c) in every other world with drag.
+        let turbulence = if variant % 4 == 2 { mpca::Turbulence { amplitude: 0.25, scale: 8, rate: 0.05 } } else { mpca::Turbulence::OFF };
+        desc.drag = Drag { rate: 0.2, wind: [0.05, 0.1, -0.05], field: variant % 4 == 0, vortex: dim == 2, turbulence };
     }
     desc.seed = 0x5eed_0000 + variant as u64;
     desc

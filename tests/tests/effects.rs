@@ -250,7 +250,7 @@ fn drag_relaxes_towards_the_flow_by_backward_euler() {
     for (vortex, field) in [(false, false), (true, false), (false, true), (true, true)] {
         let mut desc = Description::new_2d(32, 32);
         desc.vortex = Vortex { centre: [16.0, 16.0], core_radius: 4.0, circulation: 3.0 };
-        desc.drag = Drag { rate: 0.5, wind: [0.4, -0.2, 0.0], field, vortex };
+        desc.drag = Drag { rate: 0.5, wind: [0.4, -0.2, 0.0], field, vortex, ..Drag::OFF };
         desc.seed = 2;
         let mut memory = vec![0u8; mpca::world_bytes(&desc).unwrap()];
         let w = World::init(&desc, &mut memory).unwrap();
@@ -290,7 +290,7 @@ fn the_wind_plane_refuses_what_no_flow_is_and_costs_nothing_when_off() {
     for dim in [2u32, 3] {
         let mut desc = if dim == 2 { Description::new_2d(8, 8) } else { Description::new_3d(4, 4, 4) };
         let (cells, d) = (64usize, dim as usize);
-        desc.drag = Drag { rate: 0.2, wind: [0.1, 0.0, 0.0], field: false, vortex: false };
+        desc.drag = Drag { rate: 0.2, wind: [0.1, 0.0, 0.0], field: false, vortex: false, ..Drag::OFF };
         let without = mpca::world_bytes(&desc).unwrap();
         let mut memory = vec![0u8; without];
         let w = World::init(&desc, &mut memory).unwrap();
@@ -353,7 +353,7 @@ fn drag_gives_a_terminal_velocity() {
     let mut desc = Description::new_2d(64, 64);
     desc.forces.uniform = true;
     desc.gravity = [0.0, 0.01, 0.0];
-    desc.drag = Drag { rate: 0.1, wind: [0.2, 0.0, 0.0], field: false, vortex: false };
+    desc.drag = Drag { rate: 0.1, wind: [0.2, 0.0, 0.0], field: false, vortex: false, ..Drag::OFF };
     desc.seed = 3;
     let mut memory = vec![0u8; mpca::world_bytes(&desc).unwrap()];
     let w = World::init(&desc, &mut memory).unwrap();

@@ -85,8 +85,15 @@ fn small_desc() -> Description {
 /// resting contact (M5.7b).
 fn windy_desc() -> Description {
     let mut d = small_desc();
-    d.drag = Drag { rate: 0.05, wind: [0.0, 0.01, 0.0], field: true, vortex: false };
+    d.drag = Drag { rate: 0.05, wind: [0.0, 0.01, 0.0], field: true, vortex: false, ..Drag::OFF };
     d.rest = true;
+    d
+}
+
+/// The windy world with turbulence in its flow too (M5.1c).
+fn turbulent_desc() -> Description {
+    let mut d = windy_desc();
+    d.drag.turbulence = mpca::Turbulence { amplitude: 0.2, scale: 8, rate: 0.05 };
     d
 }
 
@@ -196,6 +203,8 @@ fn every_part_worlds_load_bit_identical_and_step_on_alike() {
     round_trip("small", w, 40);
     let w = small_world_of(windy_desc(), &mut memory, 25);
     round_trip("small, wind plane", w, 40);
+    let w = small_world_of(turbulent_desc(), &mut memory, 25);
+    round_trip("small, turbulence", w, 40);
 }
 
 /// An image saved from the small world at step 25, and a different world of
@@ -541,6 +550,49 @@ fn images_with_a_wind_plane_no_world_could_hold_are_refused() {
     reseal(&mut fine);
     target.load(&fine).unwrap();
     assert_eq!(image(target), fine);
+}
+
+/// M5.1c's settings in an image (M12): 16 bytes after the description
+/// (amplitude, scale, rate, a reserved word), flagged in the description's
+/// last byte. A world without turbulence writes the image it wrote before
+/// (the pinned format test); a flag of 2, a flagged section of zeros, a
+/// reserved word set, and settings the description's check refuses are
+/// refused, and change nothing.
+#[test]
+fn images_with_turbulence_no_world_could_hold_are_refused() {
+    let mut memory = Vec::new();
+    let img = image(small_world_of(turbulent_desc(), &mut memory, 7));
+    let mut other = Vec::new();
+    let target = small_world_of(turbulent_desc(), &mut other, 0);
+    let before = fingerprint(target);
+    let calm = image(small_world_of(windy_desc(), &mut Vec::new(), 0));
+    let stirred = image(small_world_of(turbulent_desc(), &mut Vec::new(), 0));
+    assert_eq!((img[DESC_AT + 119], calm[DESC_AT + 119]), (1, 0));
+    assert_eq!(stirred.len() - calm.len(), 16, "the section is what the image gains");
+    let at = DESC_AT + 120;
+    assert_eq!(f32::from_bits(u32_at(&img, at)), 0.2);
+    assert_eq!(u32_at(&img, at + 4), 8);
+    assert_eq!(f32::from_bits(u32_at(&img, at + 8)), 0.05);
+    let set_u32 = |img: &mut Vec<u8>, at: usize, v: u32| img[at..at + 4].copy_from_slice(&v.to_le_bytes());
+    type Edit = Box<dyn Fn(&mut Vec<u8>)>;
+    let cases: Vec<(&str, Edit)> = vec![
+        ("turbulence flag 2", Box::new(|i| i[DESC_AT + 119] = 2)),
+        ("a flagged section of zeros", Box::new(move |i| (0..12).for_each(|k| i[at + k] = 0))),
+        ("the reserved word", Box::new(move |i| set_u32(i, at + 12, 1))),
+        ("NaN amplitude", Box::new(move |i| set_u32(i, at, f32::NAN.to_bits()))),
+        ("amplitude 1.5", Box::new(move |i| set_u32(i, at, 1.5f32.to_bits()))),
+        ("scale 3", Box::new(move |i| set_u32(i, at + 4, 3))),
+        ("rate -0.1", Box::new(move |i| set_u32(i, at + 8, (-0.1f32).to_bits()))),
+    ];
+    for (what, edit) in cases {
+        let mut bad = img.clone();
+        edit(&mut bad);
+        reseal(&mut bad);
+        assert_eq!(target.load(&bad).map_err(Error::kind), Err(ErrorKind::ImageInvalid), "{what}");
+        assert_eq!(fingerprint(target), before, "{what}");
+    }
+    target.load(&img).unwrap();
+    assert_eq!(image(target), img);
 }
 
 #[test]

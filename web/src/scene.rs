@@ -58,7 +58,7 @@ pub fn description(kind: Kind, seed: u64) -> Description {
             d.restitution = 1.0;
             d.gravity = [0.0, 0.004, 0.0];
             d.vortex = Vortex { centre: [64.0, 72.0], core_radius: 10.0, circulation: 8.0 };
-            d.drag = Drag { rate: 0.05, wind: [0.0; 3], field: false, vortex: true };
+            d.drag = Drag { rate: 0.05, wind: [0.0; 3], field: false, vortex: true, ..Drag::OFF };
         }
         Kind::Water => {
             d.boundary = [[Boundary::Wall; 2]; 3];

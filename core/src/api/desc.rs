@@ -6,7 +6,7 @@ use core::ffi::CStr;
 
 use crate::{Error, ErrorKind};
 use crate::rules::assign::Method;
-use crate::api::checks::{finite, mass, negative, positive, restitution};
+use crate::api::checks::{finite, mass, negative, positive, restitution, size};
 
 /// What happens at one face of the domain (M4).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -76,6 +76,36 @@ pub struct Drag {
     pub field: bool,
     /// Add the vortex's velocity field to the flow.
     pub vortex: bool,
+    /// Add turbulence to the flow (M5.1c); off where its amplitude is 0.
+    pub turbulence: Turbulence,
+}
+
+impl Drag {
+    /// No drag: a rate of 0, no wind, no plane, no vortex, no turbulence.
+    pub const OFF: Drag = Drag { rate: 0.0, wind: [0.0; 3], field: false, vortex: false, turbulence: Turbulence::OFF };
+}
+
+/// M5.1c turbulence (beyond the paper): a part of the drag's flow that
+/// varies in space and time and has no divergence, the curl of a smooth
+/// noise potential computed in the step from integers, so smoke carried by
+/// it breaks up and curls without a flow from the caller. It acts through
+/// drag ([`Drag::rate`] > 0) and needs the `fields` feature.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Turbulence {
+    /// The largest any component of the turbulent flow gets, in cells per
+    /// step, `0 <= amplitude <= 1`; 0 is off.
+    pub amplitude: f32,
+    /// The size of the eddies in cells: a power of two from 1 to 1024,
+    /// dividing the size of every periodic axis.
+    pub scale: u32,
+    /// How fast the flow changes, per step, `0 <= rate <= 1`: a new random
+    /// flow every `1 / rate` steps, blended smoothly; 0 is a steady flow.
+    pub rate: f32,
+}
+
+impl Turbulence {
+    /// No turbulence.
+    pub const OFF: Turbulence = Turbulence { amplitude: 0.0, scale: 0, rate: 0.0 };
 }
 
 /// The force terms a world sums in M5.1. Uniform acceleration needs no
@@ -312,7 +342,7 @@ impl Description {
             seed: 0,
             quantization: Quantization::Bits8,
             drift: Drift::Calibrated,
-            drag: Drag { rate: 0.0, wind: [0.0; 3], field: false, vortex: false },
+            drag: Drag::OFF,
             method: Method::ExactFast,
             collisions: Collisions::Paper,
             contacts: false,
@@ -351,6 +381,10 @@ impl Description {
                 d.boundary[1][0] = Boundary::Wall;
                 d.gravity = [0.0, 0.0069, 0.0];
                 d.drag.rate = 0.033;
+                // Eddies of 16 cells that break the column up: each
+                // component of their flow up to 0.3 cells a step, above
+                // the rise, a new flow every 100 steps.
+                d.drag.turbulence = Turbulence { amplitude: 0.5, scale: 16, rate: 0.02 };
                 d.collisions = Collisions::SpeedLimited;
                 d.contacts = false;
                 d.lifetimes = true;
@@ -432,7 +466,7 @@ impl Description {
         finite(&[self.drag.rate], c"desc.drag.rate")?;
         finite(&self.drag.wind, c"desc.drag.wind")?;
         if negative(self.drag.rate) {
-            return Err(Error::new(K::BadDrag, c"desc.drag.rate"));
+            return Err(Error::new(ErrorKind::BadDrag, c"desc.drag.rate"));
         }
         if !crate::api::speed::slow(&self.drag.wind[..dim]) {
             return Err(Error::new(K::SpeedRange, c"desc.drag.wind"));
@@ -440,6 +474,7 @@ impl Description {
         if self.drag.vortex && positive(self.drag.rate) && !positive(self.vortex.core_radius) {
             return Err(Error::new(K::BadVortex, c"desc.vortex.core_radius"));
         }
+        self.check_turbulence(dim)?;
         if self.quantization == Quantization::Bits16 && !cfg!(feature = "q16") {
             return Err(Error::new(K::Q16Disabled, c"desc.quantization"));
         }
@@ -452,7 +487,7 @@ impl Description {
             && self.has_obstacles() == self.obstacles
             && self.built_forces() == self.forces
             && self.has_drag() == positive(self.drag.rate)
-            && (cfg!(feature = "fields") || !self.drag.field)
+            && (cfg!(feature = "fields") || !self.drag.field && !positive(self.drag.turbulence.amplitude))
             && self.assignment() == self.method
             && self.collision_rule() == self.collisions
             && self.has_contacts() == self.contacts
@@ -466,6 +501,35 @@ impl Description {
             return Err(Error::new(K::CapacityRange, c"desc.mass_classes"));
         }
         Ok(Checked(self))
+    }
+
+    /// M5.1c's settings, where the amplitude is above 0: each in its
+    /// range, the scale dividing every periodic axis, and drag on to carry
+    /// it. Compared through the floats' bits, as every check.
+    fn check_turbulence(&self, dim: usize) -> Result<(), Error> {
+        // Without `fields` any turbulence is refused as a part left out.
+        if !cfg!(feature = "fields") {
+            return Ok(());
+        }
+        let t = &self.drag.turbulence;
+        finite(&[t.amplitude, t.rate], c"desc.drag.turbulence")?;
+        if !positive(t.amplitude) {
+            return if negative(t.amplitude) { Err(Error::new(ErrorKind::BadDrag, c"desc.drag.turbulence.amplitude (0 to 1)")) } else { Ok(()) };
+        }
+        let problem = if size(t.amplitude) > size(1.0) {
+            c"desc.drag.turbulence.amplitude (0 to 1)"
+        } else if !t.scale.is_power_of_two() || t.scale > 1024 {
+            c"desc.drag.turbulence.scale (a power of two, 1 to 1024)"
+        } else if (0..dim).any(|k| self.boundary[k][0] == Boundary::Periodic && self.size[k] % t.scale != 0) {
+            c"desc.drag.turbulence.scale (must divide the size of every periodic axis)"
+        } else if negative(t.rate) || size(t.rate) > size(1.0) {
+            c"desc.drag.turbulence.rate (0 to 1)"
+        } else if !positive(self.drag.rate) {
+            c"desc.drag.turbulence (needs desc.drag.rate above 0)"
+        } else {
+            return Ok(());
+        };
+        Err(Error::new(ErrorKind::BadDrag, problem))
     }
 
     /// The field that asks for a part this build left out, and the feature
@@ -490,6 +554,8 @@ impl Description {
             c"desc.drag.rate needs feature `fields`"
         } else if !cfg!(feature = "fields") && self.drag.field {
             c"desc.drag.field needs feature `fields`"
+        } else if !cfg!(feature = "fields") && positive(self.drag.turbulence.amplitude) {
+            c"desc.drag.turbulence needs feature `fields`"
         } else if self.assignment() != self.method {
             c"desc.method needs feature `all-methods`"
         } else if self.collision_rule() != self.collisions {

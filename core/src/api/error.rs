@@ -37,7 +37,8 @@ pub enum ErrorKind {
     NegativeDt = 107,
     /// The vortex core radius is not greater than zero.
     BadVortex = 108,
-    /// A flow drag rate is negative (M5.1b).
+    /// A flow drag setting is out of range: a negative rate (M5.1b), or
+    /// turbulence (M5.1c).
     BadDrag = 140,
     /// A restitution lies outside `[0, 1]` (M1).
     RestitutionRange = 109,
@@ -149,7 +150,7 @@ messages! {
     NotFinite => c"a floating-point input is NaN or infinite",
     NegativeDt => c"the time step must not be negative",
     BadVortex => c"the vortex core radius must be greater than zero",
-    BadDrag => c"the flow drag rate must not be negative",
+    BadDrag => c"a flow drag setting is out of range (a negative rate, or turbulence)",
     RestitutionRange => c"a restitution lies outside [0, 1]",
     MassRange => c"a mass must be greater than zero",
     SpeedRange => c"a speed must not exceed 1 cell per step",

@@ -42,7 +42,7 @@ use core::mem::size_of;
 use core::ffi::CStr;
 
 use crate::{Error, ErrorKind};
-use crate::api::desc::{Boundary, Collisions, Description, Drag, Drift, Forces, Identity, Quantization, Vortex};
+use crate::api::desc::{Boundary, Collisions, Description, Drag, Drift, Forces, Identity, Quantization, Turbulence, Vortex};
 use crate::api::edit::storable;
 use crate::rules::assign::Method;
 use crate::rules::emitter::{checked, Emitter, EmitterStats, Slot};
@@ -86,6 +86,21 @@ const BODY_HEAD: usize = 24;
 /// step under way and the last one (3 momenta, 3 counts and a reserved
 /// word each).
 const BODY: usize = 132;
+/// The turbulence (M5.1c), after the description where the fourth of its
+/// flag bytes says so: amplitude, scale, rate and a reserved word.
+const TURBULENCE: usize = 16;
+
+/// Whether a world of description `d` keeps turbulence settings in an
+/// image: any of them not zero (from the bits, so that -0 comes back as
+/// it was). Never in a build without `fields`, whose worlds have none.
+fn turbulent(d: &Description) -> bool {
+    cfg!(feature = "fields") && !all_zero(&d.drag.turbulence)
+}
+
+/// Whether every bit of the turbulence's settings is 0.
+fn all_zero(t: &Turbulence) -> bool {
+    t.amplitude.to_bits() | t.scale | t.rate.to_bits() == 0
+}
 
 /// The bytes a world of description `d` keeps of its bodies in an image:
 /// the head and every slot of the table, or nothing without bodies.
@@ -340,6 +355,7 @@ fn image_len(d: &Description, l: &Layout, particles: usize, masses: usize, surfa
         + usize::from(ids.tags());
     [
         FIXED,
+        if turbulent(d) { TURBULENCE } else { 0 },
         body_bytes(d),
         l.occupancy().len,
         l.obstacle().len,
@@ -392,7 +408,8 @@ fn put_desc(p: &mut Put<'_>, d: &Description) {
     } = *d;
     let Forces { uniform, field, potential, vortex: swirl } = forces;
     let Vortex { centre, core_radius, circulation } = vortex;
-    let Drag { rate, wind, field: wind_plane, vortex: flow } = drag;
+    // The turbulence, where on, is written in its own section (`save`).
+    let Drag { rate, wind, field: wind_plane, vortex: flow, turbulence: _ } = drag;
     p.u32(dim);
     size.iter().for_each(|&s| p.u32(s));
     p.u64(seed);
@@ -427,10 +444,14 @@ fn put_desc(p: &mut Put<'_>, d: &Description) {
     p.u8(identity.bits() as u8);
     // The third, likewise: resting contact (M5.7b).
     p.u8(u8::from(rest));
-    p.u8(0);
+    // The fourth, likewise: the turbulence's settings follow the
+    // description (M5.1c).
+    p.u8(u8::from(turbulent(d)));
 }
 
-fn get_desc(g: &mut Get<'_>) -> Result<Description, Error> {
+/// The description, and whether the turbulence's settings follow it
+/// (which the description then lacks).
+fn get_desc(g: &mut Get<'_>) -> Result<(Description, bool), Error> {
     let bad = invalid(c"desc (a value)");
     // Taken whole, then read from the copy: every read below is at an
     // offset known when compiled, so none needs a check of its own.
@@ -483,14 +504,15 @@ fn get_desc(g: &mut Get<'_>) -> Result<Description, Error> {
     let vortex = Vortex { centre: [g.f32()?, g.f32()?], core_radius: g.f32()?, circulation: g.f32()? };
     let (restitution, wall_restitution, dt) = (g.f32()?, g.f32()?, g.f32()?);
     let (rate, wind) = (g.f32()?, [g.f32()?, g.f32()?, g.f32()?]);
-    let drag = Drag { rate, wind, field: one(g.u8()?), vortex: flow };
+    // The turbulence, where on, is read from its section after this.
+    let drag = Drag { rate, wind, field: one(g.u8()?), vortex: flow, turbulence: Turbulence::OFF };
     let identity = Identity::from_bits(u32::from(g.u8()?)).ok_or(bad)?;
     let rest = one(g.u8()?);
+    let turbulence = one(g.u8()?);
     if ones > 1 {
         return Err(invalid(c"desc (a flag)"));
     }
-    g.zeros(1)?;
-    Ok(Description {
+    let desc = Description {
         dim,
         size,
         boundary,
@@ -519,7 +541,8 @@ fn get_desc(g: &mut Get<'_>) -> Result<Description, Error> {
         emitter_capacity,
         lifetimes,
         identity,
-    })
+    };
+    Ok((desc, turbulence))
 }
 
 fn put_surface(p: &mut Put<'_>, s: &Surface) {
@@ -646,7 +669,16 @@ fn read(image: &[u8]) -> Result<Image<'_>, Error> {
     if image.len() < FIXED + CHECKSUM {
         return Err(invalid(c"length"));
     }
-    let mut desc = get_desc(&mut g)?;
+    let (mut desc, turbulence) = get_desc(&mut g)?;
+    if turbulence {
+        let section: [u8; TURBULENCE] = g.array()?;
+        let g = &mut Get { rest: &section };
+        desc.drag.turbulence = Turbulence { amplitude: g.f32()?, scale: g.u32()?, rate: g.f32()? };
+        g.zeros(4)?;
+        if all_zero(&desc.drag.turbulence) {
+            return Err(invalid(c"desc.drag.turbulence (flagged, but all zero)"));
+        }
+    }
     // M13: version 3 is a world with bodies, and only such a world.
     let (mut crushed, mut redraws) = (0, 0);
     if version == 3 {
@@ -1140,6 +1172,15 @@ impl World {
             p.u64(len as u64);
         });
         p.fixed::<DESC>(|p| put_desc(p, &h.desc));
+        if turbulent(&h.desc) {
+            let t = h.desc.drag.turbulence;
+            p.fixed::<TURBULENCE>(|p| {
+                p.f32(t.amplitude);
+                p.u32(t.scale);
+                p.f32(t.rate);
+                p.u32(0);
+            });
+        }
         #[cfg(feature = "obstacles")]
         if let Some((crushed, redraws)) = self.body_head() {
             p.fixed::<BODY_HEAD>(|p| {
@@ -1273,7 +1314,7 @@ mod tests {
         assert_eq!(size_of::<Surface>(), SURFACE);
         assert_eq!(size_of::<Slot>(), EMITTER);
         let mut g = Get { rest: &out[HEAD..HEAD + DESC] };
-        assert_eq!(get_desc(&mut g), Ok(Description::new_3d(4, 4, 4)));
+        assert_eq!(get_desc(&mut g), Ok((Description::new_3d(4, 4, 4), false)));
         assert!(g.rest.is_empty());
     }
 }

@@ -8,6 +8,7 @@
 use crate::api::desc::Vortex;
 use crate::rules::fixed::{magnitude, quot, quotient16, sat, scaled, scaled_by, to_fine, SCALED_MAX};
 use crate::rules::class::Class;
+use crate::rules::turbulence::Eddies;
 
 /// The force terms of one step, read-only, for the general force path.
 pub(crate) struct ForceTerms<'a> {
@@ -83,7 +84,7 @@ impl ForceTerms<'_> {
 
 /// The flow of M5.1b drag, read-only, for the general path: `u` at a cell
 /// is the uniform wind, plus the wind plane's value there, plus the vortex
-/// read as a velocity, in fine units (M1c).
+/// read as a velocity, plus the turbulence (M5.1c), in fine units (M1c).
 pub(crate) struct Flow<'a> {
     /// The uniform wind (M1c's `U`).
     pub wind: [i32; 3],
@@ -95,6 +96,8 @@ pub(crate) struct Flow<'a> {
     pub dim: usize,
     /// M1c's `C`: `2^16 / (1 + dt rate)`, the weight of the velocity.
     pub keep: i32,
+    /// M5.1c's turbulence of this step.
+    pub turbulence: Option<Eddies>,
 }
 
 impl Flow<'_> {
@@ -111,6 +114,12 @@ impl Flow<'_> {
             let t = v.at(pos, gamma);
             u[0] += t[0];
             u[1] += t[1];
+        }
+        if let Some(eddies) = &self.turbulence {
+            let t = eddies.at(pos);
+            for a in 0..self.dim {
+                u[a] += t[a];
+            }
         }
         u.map(sat)
     }

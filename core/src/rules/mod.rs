@@ -12,5 +12,6 @@ pub(crate) mod fixed;
 pub(crate) mod force;
 pub(crate) mod obstacle;
 pub(crate) mod quant;
+pub(crate) mod turbulence;
 pub mod rng;
 pub(crate) mod vector;

@@ -40,7 +40,7 @@ const EMITTER_WINDOW: u32 = 32;
 /// SplitMix64's output function: a bijection on u64 whose every output bit
 /// depends on every input bit.
 #[inline]
-const fn mix(mut z: u64) -> u64 {
+pub(crate) const fn mix(mut z: u64) -> u64 {
     z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
     z ^ (z >> 31)

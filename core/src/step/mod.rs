@@ -32,6 +32,8 @@ pub(crate) mod tasks;
 
 use crate::rules::fixed::{divr, magnitude, quot, scaled, scaled_by, to_fine, unit_scale};
 use crate::rules::force::{Flow, ForceTerms, Strength, Swirl};
+use crate::rules::turbulence::Eddies;
+use crate::api::checks::positive;
 use crate::rules::quant::{Quant, Width};
 use crate::rules::rng::StepKey;
 use crate::rules::class::Class;
@@ -236,7 +238,8 @@ impl World {
     #[inline(never)]
     fn setup(&mut self, lean: bool, unit: i32) -> Setup<'_> {
         let part = Partition::new(self.layout(), &self.head.desc.boundary, self.dim(), self.head.step);
-        // Read by the potential's gradient alone, which only `fields` has.
+        // Read by the potential's gradient and the turbulence, which only
+        // `fields` has.
         let periodic = if cfg!(feature = "fields") { self.periodic() } else { [false; 3] };
         let dim = self.dim();
         let (head, p) = self.planes::<u8>();
@@ -321,6 +324,8 @@ impl World {
                 unit: (s, fine),
                 dim,
                 keep: divr(1 << 48, (1 << 32) + scaled(desc.dt, desc.drag.rate, 32) as u64) as i32,
+                turbulence: positive(desc.drag.turbulence.amplitude)
+                    .then(|| Eddies::of(&desc.drag.turbulence, desc.seed, head.step, dim, n, periodic, (s, fine))),
             }),
             moves: crate::rules::quant::move_table_8(desc.drift),
             #[cfg(not(feature = "small-step"))]

@@ -1,6 +1,7 @@
 //! The rules beyond the paper (docs/model.md, "Additions"), each against
 //! the paper's rule on the scene where the difference shows (M10): flow
-//! drag on the smoke, speed-limited collisions on the e = 1 cluster,
+//! drag on the smoke, turbulence on the smoke preset's plume,
+//! speed-limited collisions on the e = 1 cluster,
 //! contacts and resting contact on the poured water pool, energy-neutral
 //! rounding in an
 //! elastic 8-bit box. The figures are those the tests of
@@ -8,7 +9,7 @@
 
 use mpca::{Boundary, Collisions, Description, Error, World};
 
-use super::{memory, repeat, run_steps, Timing};
+use super::{memory, plume, repeat, run_steps, Timing};
 use crate::scenes::{self, Scene};
 
 /// One figure of one rule: its value under the paper's rule and under the
@@ -78,6 +79,9 @@ fn step_and_read(w: &mut World, steps: u64) -> (Ended, f64) {
 /// A figure of a run: its name and how it is read.
 type Figure = (&'static str, fn(&Ended) -> f64);
 
+/// A figure of a plume (M5.1c), likewise.
+type PlumeFigure = (&'static str, fn(&plume::Plume) -> f64);
+
 /// The figures `figures` of the pair of runs `(paper, addition)`.
 fn rows(
     rule: &'static str,
@@ -129,6 +133,34 @@ pub fn measure(share: f64, box_steps: u64, runs: usize) -> Vec<AdditionRow> {
         run(&flow, b, runs),
         (a, b),
     ));
+
+    // M5.1c: the smoke preset's plume with drag alone against drag with
+    // its turbulence (the figures tests/tests/turbulence.rs holds).
+    let (calm, stirred) = (scenes::plume(false, 1), scenes::plume(true, 1));
+    let n = steps(calm.steps);
+    let plume_run = |scene: &Scene| {
+        let scene = Scene { steps: n, ..*scene };
+        repeat(runs, || plume::measure(&scene))
+    };
+    let (calm_run, stirred_run) = (plume_run(&calm), plume_run(&stirred));
+    let figures: [PlumeFigure; 4] = [
+        ("plume width 8 to 24 cells up, cells", |p| p.width[0]),
+        ("plume width 104 to 120 cells up, cells", |p| p.width[3]),
+        ("r.m.s. sideways velocity", |p| p.sideways),
+        ("clamps per particle-step", |p| p.clamps),
+    ];
+    for (measure, f) in figures {
+        out.push(AdditionRow {
+            rule: "M5.1c turbulence",
+            scenes: "plume of the smoke preset, 128²".into(),
+            measure,
+            paper: f(&calm_run.0),
+            addition: f(&stirred_run.0),
+            steps: (n, n),
+            paper_timing: calm_run.1.clone(),
+            addition_timing: stirred_run.1.clone(),
+        });
+    }
 
     // M5.2b: the e = 1 cluster collision, paper collisions against
     // speed-limited ones.

@@ -13,6 +13,7 @@ pub mod assignment;
 pub mod conservation;
 pub mod cooling;
 pub mod drift;
+pub mod plume;
 pub mod scenes;
 pub mod walls;
 

@@ -753,7 +753,10 @@ fn additions(r: &Results) -> Table {
         "additions",
         "The rules beyond the paper against the paper's (docs/model.md, Additions)",
         "Each rule beyond the paper on the scene where it shows, against the paper's rule: the paper's smoke (480 \
-         steps, its vortex as a force) against the smoke with flow drag (its 1,200 steps); the e = 1 cluster with \
+         steps, its vortex as a force) against the smoke with flow drag (its 1,200 steps); the smoke preset's \
+         plume from a vent in a 128² world, with drag alone and with the preset's turbulence (M5.1c: the \
+         \"paper rule\" column is then drag alone; widths over the last 600 of 1,200 steps, the figures of \
+         `tests/tests/turbulence.rs`); the e = 1 cluster with \
          the paper's collisions and with speed-limited ones; the poured water pool (e = 0.5) without and with \
          contacts, and with contacts without and with resting contact (M5.7b: the \"paper rule\" column is \
          then M5.7 alone), and 8 full rows dropped under gravity 0.02 in a 64 × 48 box, without and with \
