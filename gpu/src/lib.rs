@@ -50,7 +50,7 @@ pub use export::Exports;
 
 use std::ffi::CStr;
 
-use mpca::port::{DragConstants, PortPlanes, StepConstants, StepCounts, VortexConstants};
+use mpca::port::{DragConstants, PortPlanes, StepConstants, StepCounts, TurbulenceConstants, VortexConstants};
 use mpca::{Boundary, Collisions, Description, Drift, Method, Quantization, World, WorldBox};
 use wgpu::util::DeviceExt;
 
@@ -183,14 +183,13 @@ pub fn unsupported(d: &Description) -> Option<&'static str> {
 /// What [`unsupported`] names, and the detail of the refusal: the field
 /// that asks for it.
 fn refusal(d: &Description) -> Option<(&'static CStr, &'static str)> {
-    let checks: [(bool, &'static CStr, &'static str); 4] = [
+    let checks: [(bool, &'static CStr, &'static str); 3] = [
         // Correct where loops are not limited, but a dense 3D block's search
         // (8! leaves) runs past the loop limit of Mesa's lavapipe, which
         // ends a shader's loops after 65,535 iterations in all: untested.
         (d.dim == 2 || d.method != Method::Exhaustive, c"desc.method: exhaustive assignment in 3D", "exhaustive assignment in 3D"),
         (!(d.obstacles && d.body_capacity > 0), c"desc.body_capacity: bodies, obstacles the caller moves (M13)", "bodies, obstacles the caller moves (M13)"),
         (!d.rest, c"desc.rest: resting contact (M5.7b)", "resting contact (M5.7b)"),
-        (!(d.drag.rate > 0.0 && d.drag.turbulence.amplitude > 0.0), c"desc.drag.turbulence: turbulence (M5.1c)", "turbulence (M5.1c)"),
     ];
     checks.iter().find(|(ok, ..)| !ok).map(|&(_, detail, part)| (detail, part))
 }
@@ -645,7 +644,7 @@ fn counters_of(host: &World) -> [u32; COUNTERS] {
 }
 
 /// The shader's parameters (`rule.wgsl`).
-const PARAMS: usize = 55;
+const PARAMS: usize = 62;
 
 /// A face as the shader reads it: 0 periodic, 1 wall, 2 open.
 fn face(b: Boundary) -> u32 {
@@ -667,7 +666,8 @@ fn params(c: &StepConstants, d: &Description, d_emitters: u32, surfaces: u32) ->
     let g = c.push.map(|g| g as u64);
     let v = c.vortex.unwrap_or(VortexConstants { centre: [0; 2], core: 0, flow: None });
     let flow = v.flow.unwrap_or_default();
-    let drag = c.drag.unwrap_or(DragConstants { keep: 0, wind: [0; 3], field: false });
+    let drag = c.drag.unwrap_or(DragConstants { keep: 0, wind: [0; 3], field: false, turbulence: None });
+    let eddies = drag.turbulence.unwrap_or(TurbulenceConstants { rate: 0, base: 0, t: 0, shift: 0, lambda: 0 });
     let on = |x: bool| u32::from(x);
     [
         lo(d.seed),
@@ -725,5 +725,12 @@ fn params(c: &StepConstants, d: &Description, d_emitters: u32, surfaces: u32) ->
         on(d.per_particle_mass),
         d.identity.bits(),
         d.method as u32,
+        on(drag.turbulence.is_some()),
+        eddies.rate,
+        lo(eddies.base),
+        hi(eddies.base),
+        eddies.t as u32,
+        eddies.shift as u32,
+        eddies.lambda,
     ]
 }

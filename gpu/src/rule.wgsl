@@ -33,7 +33,9 @@
 // uniform wind U's x and y (fine units), 47 the flow holds the wind plane,
 // 48 the flow holds the vortex, 49 S (quanta to a unit speed), 50
 // obstacles, 51 energy-neutral rounding (M1b), 52 masses, 53 M6b's planes,
-// 54 M5.6's method (0 exhaustive, 1 exact-fast, 2 greedy). 3-5, 13, 33-34
+// 54 M5.6's method (0 exhaustive, 1 exact-fast, 2 greedy), 55 turbulence
+// (M5.1c) in the flow, 56 its R (Q16), 57-58 its β (64-bit pair), 59 its
+// t, 60 its shift e - 30 (i32), 61 its log2(scale). 3-5, 13, 33-34
 // and 37 are 0: what depends on the mass (K, the clamp's energy factor,
 // the vortex force's strength) is in `classes`, per mass index.
 @group(0) @binding(0) var<storage, read> params: array<u32>;
@@ -703,9 +705,130 @@ fn push_at(p: vec3<u32>, mass_class: u32) -> array<vec2<u32>, 3> {
     return dv;
 }
 
+// ---- M5.1c: turbulence ---------------------------------------------------
+
+// The turbulence of this invocation's step (`eddies_of`), where it is on.
+struct Eddies {
+    keys: vec2<u32>,
+    // Per axis, its size where it is periodic, else 0.
+    wrap: vec3<u32>,
+    time: u32,
+}
+
+var<private> eddies: Eddies;
+
+fn h32(x0: u32) -> u32 {
+    var x = (x0 ^ (x0 >> 16u)) * 0x1ce4e5b9u;
+    x = (x ^ (x >> 15u)) * 0x133111ebu;
+    return x ^ (x >> 16u);
+}
+
+fn smoothstep15(x: u32) -> u32 {
+    return (((x * x) >> 15u) * (3u * 32768u - 2u * x)) >> 15u;
+}
+
+fn lerp15(a: i32, b: i32, w: u32) -> i32 {
+    return a + (((b - a) * i32(w)) >> 15u);
+}
+
+// The step's two slices' keys and the weight between them.
+fn eddies_of(step: vec2<u32>) -> Eddies {
+    let phase = mul64(step, vec2<u32>(params[56], 0u));
+    let slice = shr64(phase, 16u);
+    let base = vec2<u32>(params[57], params[58]);
+    var e: Eddies;
+    e.keys = vec2<u32>(mix64(base ^ slice).x, mix64(base ^ add64(slice, vec2<u32>(1u, 0u))).x);
+    let n = sizes();
+    for (var k = 0u; k < DIM; k++) {
+        e.wrap[k] = select(0u, n[k], face(k, false) == 0u);
+    }
+    e.time = smoothstep15((phase.x & 0xffffu) >> 1u);
+    return e;
+}
+
+// Component c of the potential at a corner: the lattice values round it
+// blended along x, then y, then z for each slice (a value blended with the
+// one kept for its axis as soon as its partner is known), then the slices.
+fn eddy_potential(corner: vec3<u32>, c: u32) -> i32 {
+    let lambda = params[61];
+    var points: array<vec2<u32>, 3>;
+    var w = vec3<u32>(0u);
+    for (var k = 0u; k < DIM; k++) {
+        let i = corner[k] >> lambda;
+        points[k] = vec2<u32>(i, select(i + 1u, 0u, i + 1u == eddies.wrap[k] >> lambda));
+        w[k] = smoothstep15((corner[k] & ((1u << lambda) - 1u)) << (15u - lambda));
+    }
+    var slices = vec2<i32>(0);
+    for (var j = 0u; j < 2u; j++) {
+        let key = eddies.keys[j];
+        var kept = vec3<i32>(0);
+        for (var m = 0u; m < CELLS; m++) {
+            var x = c * 0xa0761d65u;
+            let spread = vec3<u32>(0x9e3779b9u, 0xbf58476du, 0x94d049bbu);
+            for (var k = 0u; k < DIM; k++) {
+                x += points[k][m >> k & 1u] * spread[k];
+            }
+            var value = bitcast<i32>(h32(key ^ x)) >> 16u;
+            // Loops of constant bounds only (`carry` the first axis whose
+            // bit is 0): a compiler unrolls them, and lavapipe counts the
+            // iterations of the loops it does not against its limit.
+            var carry = DIM;
+            for (var k = 0u; k < DIM; k++) {
+                if carry == DIM && (m >> k & 1u) == 0u {
+                    carry = k;
+                }
+                if carry == DIM {
+                    value = lerp15(kept[k], value, w[k]);
+                }
+            }
+            if carry < DIM {
+                kept[carry] = value;
+            } else {
+                slices[j] = value;
+            }
+        }
+    }
+    return lerp15(slices.x, slices.y, eddies.time);
+}
+
+// The turbulent flow at cell p in fine units: d = sum of sign x A over the
+// cell's corners (A = (0, 0, psi) in 2D), times t, shifted.
+fn turbulence_at(p: vec3<u32>) -> vec3<i32> {
+    var d = vec3<i32>(0);
+    for (var m = 0u; m < CELLS; m++) {
+        var corner = vec3<u32>(0u);
+        var sign = vec3<i32>(0);
+        for (var k = 0u; k < DIM; k++) {
+            let upper = (m >> k & 1u) != 0u;
+            let q = p[k] + select(0u, 1u, upper);
+            corner[k] = select(q, 0u, upper && q == eddies.wrap[k]);
+            sign[k] = select(-1, 1, upper);
+        }
+        var a = vec3<i32>(0);
+        for (var c = 0u; c < 3u; c++) {
+            if DIM == 3u || c == 2u {
+                a[c] = eddy_potential(corner, c);
+            }
+        }
+        d += vec3<i32>(sign.y * a.z - sign.z * a.y, sign.z * a.x - sign.x * a.z, sign.x * a.y - sign.y * a.x);
+    }
+    let t = bitcast<i32>(params[59]);
+    let shift = bitcast<i32>(params[60]);
+    var u = vec3<i32>(0);
+    for (var k = 0u; k < DIM; k++) {
+        let y = d[k] * t;
+        if shift >= 0 {
+            u[k] = y << u32(shift);
+        } else {
+            u[k] = y >> u32(min(-shift, 31));
+        }
+    }
+    return u;
+}
+
 // M5.1b's flow at cell p in fine units: the uniform wind, the wind plane's
-// value and the vortex read as a velocity, where each is on, each
-// component saturated to +-2^30.
+// value, the vortex read as a velocity and the turbulence (M5.1c), where
+// each is on, each component saturated to +-2^30.
 fn flow_at(p: vec3<u32>) -> vec3<i32> {
     let cell = cell_index(p);
     let uniform = vec3<i32>(bitcast<i32>(params[45]), bitcast<i32>(params[46]), bitcast<i32>(params[12]));
@@ -720,6 +843,12 @@ fn flow_at(p: vec3<u32>) -> vec3<i32> {
         let t = swirl(p.x, p.y, bitcast<i32>(params[41]), bitcast<i32>(params[42]));
         u[0] = add64(u[0], t[0]);
         u[1] = add64(u[1], t[1]);
+    }
+    if params[55] != 0u {
+        let t = turbulence_at(p);
+        for (var k = 0u; k < DIM; k++) {
+            u[k] = add64(u[k], wide64(t[k]));
+        }
     }
     var out = vec3<i32>(0);
     for (var k = 0u; k < DIM; k++) {
@@ -1410,6 +1539,9 @@ fn sweep(@builtin(global_invocation_id) id: vec3<u32>) {
     let nx = n.x;
     let row_u32 = params[8];
     let step = vec2<u32>(atomicLoad(&counters[13]), atomicLoad(&counters[14]));
+    if params[55] != 0u {
+        eddies = eddies_of(step);
+    }
     let o = step.x & 1u;
     // M3: per axis the first block's lowest cell and the block count (one
     // block along z in 2D).

@@ -148,11 +148,6 @@ fn a_part_the_backend_does_not_run_is_refused() {
     d.rest = true;
     let w = WorldBox::new(&d).unwrap();
     assert_eq!(refused(&w), Some((mpca::ErrorKind::FeatureDisabled, "desc.rest: resting contact (M5.7b)")));
-    let mut d = Description::new_2d(16, 16);
-    d.drag = mpca::Drag { rate: 0.1, turbulence: mpca::Turbulence { amplitude: 0.2, scale: 8, rate: 0.05 }, ..mpca::Drag::OFF };
-    let w = WorldBox::new(&d).unwrap();
-    assert_eq!(refused(&w), Some((mpca::ErrorKind::FeatureDisabled, "desc.drag.turbulence: turbulence (M5.1c)")));
-    assert_eq!(mpca_gpu::unsupported(w.description()), Some("turbulence (M5.1c)"));
 }
 
 #[test]
@@ -512,6 +507,36 @@ fn the_smoke_scene_with_flow_drag_steps_as_on_the_cpu() {
 }
 
 #[test]
+fn the_turbulent_plume_steps_as_on_the_cpu() {
+    // M5.1c: the smoke preset's plume with its turbulence (eddies of 16
+    // cells, open faces and a floor); 600 steps, compared every 50.
+    let mut scene = mpca_tests::scenes::plume(true, 4);
+    scene.steps = 600;
+    same_scene(scene, 50);
+}
+
+#[test]
+fn turbulence_steps_as_on_the_cpu_in_3d() {
+    // M5.1c in 3D: the three components of the potential, periodic x and z
+    // (the lattice and the corners wrap), walls on y, at both widths.
+    for quantization in [mpca::Quantization::Bits8, mpca::Quantization::Bits16] {
+        let mut w = gas_3d(
+            [16, 8, 8],
+            0.3,
+            171,
+            |d| {
+                d.quantization = quantization;
+                d.boundary[1] = [mpca::Boundary::Wall; 2];
+                let turbulence = mpca::Turbulence { amplitude: 0.6, scale: 4, rate: 0.1 };
+                d.drag = mpca::Drag { rate: 0.3, turbulence, ..mpca::Drag::OFF };
+            },
+            |_| {},
+        );
+        same_worlds(&mut w, 30, 1);
+    }
+}
+
+#[test]
 fn force_fields_potentials_and_drag_step_as_on_the_cpu() {
     // Every per-cell term at once, from random planes (some values large
     // enough to saturate M1c's conv, some tiny): a force field, a
@@ -526,7 +551,9 @@ fn force_fields_potentials_and_drag_step_as_on_the_cpu() {
             d.forces.potential = true;
             d.forces.vortex = true;
             d.vortex = mpca::Vortex { centre: [17.0, 10.5], core_radius: 4.0, circulation: 3.0 };
-            d.drag = mpca::Drag { rate: 0.2, wind: [0.1, -0.05, 0.0], field: true, vortex: true, ..mpca::Drag::OFF };
+            // Turbulence of eddies of 2 cells: 2 divides the periodic 34.
+            let turbulence = mpca::Turbulence { amplitude: 0.3, scale: 2, rate: 0.3 };
+            d.drag = mpca::Drag { rate: 0.2, wind: [0.1, -0.05, 0.0], field: true, vortex: true, turbulence };
             d.mass = 1.7;
         });
         let mut rng = mpca::rng::block_stream(82, 0, 0);
@@ -777,7 +804,8 @@ fn forces_masses_and_collision_rules_step_as_on_the_cpu_in_3d() {
                 d.forces = mpca::Forces { uniform: true, field: true, potential: true, vortex: true };
                 d.gravity = [0.0, 0.004, -0.002];
                 d.vortex = mpca::Vortex { centre: [9.0, 5.5], core_radius: 3.0, circulation: 2.5 };
-                d.drag = mpca::Drag { rate: 0.2, wind: [0.1, -0.05, 0.07], field: true, vortex: true, ..mpca::Drag::OFF };
+                let turbulence = mpca::Turbulence { amplitude: 0.4, scale: 2, rate: 0.3 };
+                d.drag = mpca::Drag { rate: 0.2, wind: [0.1, -0.05, 0.07], field: true, vortex: true, turbulence };
                 d.per_particle_mass = true;
                 d.mass_classes = 8;
                 d.collisions = mpca::Collisions::SpeedLimited;

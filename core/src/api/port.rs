@@ -20,6 +20,8 @@ use crate::rules::quant::unit_of;
 use crate::step::convert_class;
 use crate::step::partition::Partition;
 use crate::storage::layout::stored;
+use crate::api::checks::positive;
+pub use crate::rules::turbulence::TurbulenceConstants;
 use crate::storage::world::{Counters, World};
 
 /// The integers one step of a world reads, converted from its description
@@ -85,6 +87,8 @@ pub struct DragConstants {
     pub wind: [i32; 3],
     /// The flow adds the wind plane.
     pub field: bool,
+    /// The flow adds turbulence (M5.1c).
+    pub turbulence: Option<TurbulenceConstants>,
 }
 
 /// An emitter as a step reads it (M6, M1c).
@@ -221,6 +225,8 @@ impl World {
                 keep: divr(1 << 48, (1 << 32) + scaled(desc.dt, desc.drag.rate, 32) as u64) as i32,
                 wind: desc.drag.wind.map(|u| to_fine(u, (s, fine))),
                 field: desc.drag.field,
+                turbulence: positive(desc.drag.turbulence.amplitude)
+                    .then(|| TurbulenceConstants::of(&desc.drag.turbulence, desc.seed, desc.dim as usize, (s, fine))),
             }),
         }
     }

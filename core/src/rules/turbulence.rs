@@ -1,7 +1,7 @@
 //! M5.1c turbulence: the curl of a value-noise potential taken at the cell
 //! corners, a part of M5.1b's flow. Every operation is on 32-bit integers
-//! (a shader has no wider ones), and everything a step shares is converted
-//! once, in [`Eddies::of`].
+//! (a shader has no wider ones); the settings are converted once a world
+//! ([`TurbulenceConstants`]), the time slices once a step ([`Eddies`]).
 
 use crate::api::desc::Turbulence;
 use crate::rules::fixed::{divr, scaled, scaled_by};
@@ -55,29 +55,57 @@ const fn lerp(a: i32, b: i32, w: u32) -> i32 {
     a + (((b - a) * w as i32) >> 15)
 }
 
-impl Eddies {
-    /// The turbulence `t` of step `step` in a world of `dim` axes of `n`
-    /// cells (`periodic` where they wrap), for the unit speed `(s, fine)`
-    /// (M1c). [`Description::check`](crate::Description) has checked `t`.
-    pub(crate) fn of(t: &Turbulence, seed: u64, step: u64, dim: usize, n: [usize; 3], periodic: [bool; 3], (s, fine): (u32, i32)) -> Eddies {
-        let lambda = t.scale.trailing_zeros();
-        let phase = step.wrapping_mul(scaled(t.rate, 1.0, 16) as u64);
-        let slice = phase >> 16;
-        let base = mix(seed ^ DOMAIN);
-        let keys = [0, 1].map(|j| mix(base ^ slice.wrapping_add(j)) as u32);
+/// M5.1c's settings as every step reads them (M1c), for the step here and
+/// for a second implementation (`mpca::port`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TurbulenceConstants {
+    /// `R = conv(rate, 1, 16)`: the slices' phase gained a step, in Q16.
+    pub rate: u32,
+    /// `β = mix(seed ⊕ "mpcatrb")`, from which each slice's key is mixed.
+    pub base: u64,
+    /// `T`'s top 12 bits, `t`.
+    pub t: i32,
+    /// `e - 30`: where `d t` is shifted left (or, below 0, right) to fine
+    /// units.
+    pub shift: i32,
+    /// `log2(scale)`.
+    pub lambda: u32,
+}
+
+impl TurbulenceConstants {
+    /// The turbulence `t` of a `dim`-dimensional world of seed `seed`, for
+    /// the unit speed `(s, fine)` (M1c). [`Description::check`](crate::Description)
+    /// has checked `t`.
+    pub(crate) fn of(t: &Turbulence, seed: u64, dim: usize, (s, fine): (u32, i32)) -> TurbulenceConstants {
         // The scale of a unit `d`, `a W scale / (3 2^16 q)` in units of
         // 2^-30, and its top 12 bits.
         let q_bits = if dim == 3 { 2 } else { 0 };
         let big = divr(scaled_by(t.amplitude, t.scale as f32, s, fine + 14 - q_bits) as u64, 3);
         let bits = 64 - big.leading_zeros() as i32;
-        let top = if bits > 12 { big >> (bits - 12) } else { big << (12 - bits) } as i32;
+        TurbulenceConstants {
+            rate: scaled(t.rate, 1.0, 16) as u32,
+            base: mix(seed ^ DOMAIN),
+            t: if bits > 12 { big >> (bits - 12) } else { big << (12 - bits) } as i32,
+            shift: bits - 12 - 30,
+            lambda: t.scale.trailing_zeros(),
+        }
+    }
+}
+
+impl Eddies {
+    /// The turbulence of step `step` in a world of `dim` axes of `n` cells
+    /// (`periodic` where they wrap) whose settings are `c`: the two time
+    /// slices' keys and the weight between them.
+    pub(crate) fn of(c: &TurbulenceConstants, step: u64, dim: usize, n: [usize; 3], periodic: [bool; 3]) -> Eddies {
+        let phase = step.wrapping_mul(u64::from(c.rate));
+        let slice = phase >> 16;
         Eddies {
-            keys,
+            keys: [0, 1].map(|j| mix(c.base ^ slice.wrapping_add(j)) as u32),
             wrap: [0, 1, 2].map(|k| if periodic[k] { n[k] as u32 } else { 0 }),
             time: smooth((phase & 0xffff) as u32 >> 1) as u16,
-            t: top as i16,
-            shift: (bits - 12 - 30).clamp(-64, 63) as i8,
-            lambda: lambda as u8,
+            t: c.t as i16,
+            shift: c.shift.clamp(-64, 63) as i8,
+            lambda: c.lambda as u8,
             dim: dim as u8,
         }
     }
@@ -177,7 +205,7 @@ mod tests {
 
     fn eddies(dim: usize, scale: u32, n: [usize; 3], periodic: [bool; 3], step: u64) -> Eddies {
         let t = Turbulence { amplitude: 0.3, scale, rate: 0.05 };
-        Eddies::of(&t, 7, step, dim, n, periodic, (127, 16))
+        Eddies::of(&TurbulenceConstants::of(&t, 7, dim, (127, 16)), step, dim, n, periodic)
     }
 
     /// M5.1c: over the cells round every corner inside the grid (and, on

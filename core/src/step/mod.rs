@@ -32,7 +32,7 @@ pub(crate) mod tasks;
 
 use crate::rules::fixed::{divr, magnitude, quot, scaled, scaled_by, to_fine, unit_scale};
 use crate::rules::force::{Flow, ForceTerms, Strength, Swirl};
-use crate::rules::turbulence::Eddies;
+use crate::rules::turbulence::{Eddies, TurbulenceConstants};
 use crate::api::checks::positive;
 use crate::rules::quant::{Quant, Width};
 use crate::rules::rng::StepKey;
@@ -324,8 +324,10 @@ impl World {
                 unit: (s, fine),
                 dim,
                 keep: divr(1 << 48, (1 << 32) + scaled(desc.dt, desc.drag.rate, 32) as u64) as i32,
-                turbulence: positive(desc.drag.turbulence.amplitude)
-                    .then(|| Eddies::of(&desc.drag.turbulence, desc.seed, head.step, dim, n, periodic, (s, fine))),
+                turbulence: positive(desc.drag.turbulence.amplitude).then(|| {
+                    let c = TurbulenceConstants::of(&desc.drag.turbulence, desc.seed, dim, (s, fine));
+                    Eddies::of(&c, head.step, dim, n, periodic)
+                }),
             }),
             moves: crate::rules::quant::move_table_8(desc.drift),
             #[cfg(not(feature = "small-step"))]
