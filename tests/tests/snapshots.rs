@@ -399,12 +399,10 @@ fn images_resealed_around_content_no_world_holds_are_refused() {
     let occ = move |img: &[u8], y: usize| u64_at(img, p.occupancy + 8 * y);
     let obs = move |img: &[u8], y: usize| u64_at(img, p.obstacle + 8 * y);
     let set_u64 = |img: &mut Vec<u8>, at: usize, v: u64| img[at..at + 8].copy_from_slice(&v.to_le_bytes());
-    let set_u32 = |img: &mut Vec<u8>, at: usize, v: u32| img[at..at + 4].copy_from_slice(&v.to_le_bytes());
     // A row holding a particle, and one holding an obstacle cell free of particles.
     let row = (0..16).find(|&y| occ(&img, y) != 0).unwrap();
     let obstacle_row = (0..16).find(|&y| obs(&img, y) & !occ(&img, y) != 0).unwrap();
 
-    type Edit = Box<dyn Fn(&mut Vec<u8>)>;
     // Each with the kind and the detail naming the part at fault.
     let cases: Vec<(&str, ErrorKind, &str, Edit)> = vec![
         ("version 4", ErrorKind::ImageVersion, "header: version", Box::new(move |i| set_u32(i, VERSION_AT, 4))),
@@ -505,6 +503,26 @@ fn images_resealed_around_content_no_world_holds_are_refused() {
     println!("{n} re-sealed images refused");
 }
 
+/// An edit of an image's bytes.
+type Edit = Box<dyn Fn(&mut Vec<u8>)>;
+
+/// Writes `v` little-endian at `at`.
+fn set_u32(img: &mut [u8], at: usize, v: u32) {
+    img[at..at + 4].copy_from_slice(&v.to_le_bytes());
+}
+
+/// Each edit of `img`, resealed, is refused by `target` as `ImageInvalid`
+/// and leaves it as `before`.
+fn refused_as_invalid(img: &[u8], target: &mut World, before: &Fingerprint, cases: Vec<(&str, Edit)>) {
+    for (what, edit) in cases {
+        let mut bad = img.to_vec();
+        edit(&mut bad);
+        reseal(&mut bad);
+        assert_eq!(target.load(&bad).map_err(Error::kind), Err(ErrorKind::ImageInvalid), "{what}");
+        assert_eq!(&fingerprint(target), before, "{what}");
+    }
+}
+
 /// M5.1b's wind plane in an image (M12): after the force planes, `dim`
 /// floats a cell, flagged in the description's byte 116. A world without
 /// the plane writes the image it wrote before the plane existed (the
@@ -525,8 +543,6 @@ fn images_with_a_wind_plane_no_world_could_hold_are_refused() {
     let tables = 4 * u32_at(&img, TABLES_AT) as usize + 24 * u32_at(&img, TABLES_AT + 4) as usize + 72 * u32_at(&img, TABLES_AT + 8) as usize;
     let wind = img.len() - 4 - tables - 256 * 2 * 4;
     assert_eq!(wet.len() - dry.len(), 256 * 2 * 4, "the plane is what the image gains");
-    let set_u32 = |img: &mut Vec<u8>, at: usize, v: u32| img[at..at + 4].copy_from_slice(&v.to_le_bytes());
-    type Edit = Box<dyn Fn(&mut Vec<u8>)>;
     let cases: Vec<(&str, Edit)> = vec![
         ("wind-plane flag 2", Box::new(|i| i[DESC_AT + 116] = 2)),
         ("NaN wind", Box::new(move |i| set_u32(i, wind + 12, f32::NAN.to_bits()))),
@@ -536,13 +552,7 @@ fn images_with_a_wind_plane_no_world_could_hold_are_refused() {
             set_u32(i, wind + 12, (-1.04f32).to_bits());
         })),
     ];
-    for (what, edit) in cases {
-        let mut bad = img.clone();
-        edit(&mut bad);
-        reseal(&mut bad);
-        assert_eq!(target.load(&bad).map_err(Error::kind), Err(ErrorKind::ImageInvalid), "{what}");
-        assert_eq!(fingerprint(target), before, "{what}");
-    }
+    refused_as_invalid(&img, target, &before, cases);
     // Read back as written: a wind of speed exactly within 1 is taken.
     let mut fine = img.clone();
     set_u32(&mut fine, wind + 8, 0.6f32.to_bits());
@@ -573,8 +583,6 @@ fn images_with_turbulence_no_world_could_hold_are_refused() {
     assert_eq!(f32::from_bits(u32_at(&img, at)), 0.2);
     assert_eq!(u32_at(&img, at + 4), 8);
     assert_eq!(f32::from_bits(u32_at(&img, at + 8)), 0.05);
-    let set_u32 = |img: &mut Vec<u8>, at: usize, v: u32| img[at..at + 4].copy_from_slice(&v.to_le_bytes());
-    type Edit = Box<dyn Fn(&mut Vec<u8>)>;
     let cases: Vec<(&str, Edit)> = vec![
         ("turbulence flag 2", Box::new(|i| i[DESC_AT + 119] = 2)),
         ("a flagged section of zeros", Box::new(move |i| (0..12).for_each(|k| i[at + k] = 0))),
@@ -584,13 +592,7 @@ fn images_with_turbulence_no_world_could_hold_are_refused() {
         ("scale 3", Box::new(move |i| set_u32(i, at + 4, 3))),
         ("rate -0.1", Box::new(move |i| set_u32(i, at + 8, (-0.1f32).to_bits()))),
     ];
-    for (what, edit) in cases {
-        let mut bad = img.clone();
-        edit(&mut bad);
-        reseal(&mut bad);
-        assert_eq!(target.load(&bad).map_err(Error::kind), Err(ErrorKind::ImageInvalid), "{what}");
-        assert_eq!(fingerprint(target), before, "{what}");
-    }
+    refused_as_invalid(&img, target, &before, cases);
     target.load(&img).unwrap();
     assert_eq!(image(target), img);
 }
