@@ -217,9 +217,9 @@ impl World {
         for i in 0..count {
             let b = body(i);
             let b = if b.kind == 0 { Body::ZERO } else { self.with_fine_velocity(b) };
-            head_and_bodies(self.planes::<u8>().1.bodies).1[i] = b;
+            head_and_bodies(self.byte_planes().1.bodies).1[i] = b;
         }
-        let (_, p) = self.planes::<u8>();
+        let (_, p) = &mut self.byte_planes();
         if let (Some(h), _) = head_and_bodies(p.bodies) {
             *h = BodiesHead { crushed, redraws, surfaces: 0 };
         }
@@ -305,10 +305,10 @@ impl World {
         if self.with_draw(change, |d| d.entries()) > self.head.desc.body_surface_capacity as usize {
             return Err(Error::new(ErrorKind::SurfaceTableFull, c"desc.body_surface_capacity"));
         }
-        head_and_bodies(self.planes::<u8>().1.bodies).1[change.slot] = change.body;
+        head_and_bodies(self.byte_planes().1.bodies).1[change.slot] = change.body;
         self.refresh_bodies();
         self.push_out();
-        let (_, p) = self.planes::<u8>();
+        let (_, p) = &mut self.byte_planes();
         if let (Some(h), _) = head_and_bodies(p.bodies) {
             h.redraws = h.redraws.wrapping_add(1);
         }
@@ -325,7 +325,7 @@ impl World {
         if self.bodies().is_err() {
             return;
         }
-        let (_, p) = self.planes::<u8>();
+        let (_, p) = &mut self.byte_planes();
         for (o, b) in p.obstacle.iter_mut().zip(p.body_cells.iter_mut()) {
             *o &= !*b;
             *b = 0;
@@ -335,7 +335,7 @@ impl World {
         for_cells(lo, hi, &mut |c| {
             if self.with_draw(none, |d| d.owner(c).is_some()) {
                 let bit = l.site(c[0], c[1], c[2]).bit;
-                let (_, p) = self.planes::<u8>();
+                let (_, p) = &mut self.byte_planes();
                 put_bit(Cells::new(p.obstacle), bit, true);
                 put_bit(Cells::new(p.body_cells), bit, true);
             }
@@ -346,13 +346,13 @@ impl World {
             let taken = |q: [usize; 3]| w.is_obstacle(l.site(q[0], q[1], q[2]));
             let entry = w.with_draw(none, |d| d.owner(c).and_then(|(i, b)| d.entry(&taken, c, i, &b)));
             if let Some(e) = entry {
-                let (_, p) = self.planes::<u8>();
+                let (_, p) = &mut self.byte_planes();
                 p.body_surface[used] = e;
                 p.body_tally[used] = Default::default();
                 used += 1;
             }
         });
-        let (_, p) = self.planes::<u8>();
+        let (_, p) = &mut self.byte_planes();
         if let (Some(h), _) = head_and_bodies(p.bodies) {
             h.surfaces = used as u32;
         }
@@ -423,7 +423,7 @@ impl World {
     fn push_one(&mut self, from: Site, to: Option<Site>, i: usize, b: &Body, n: [i32; 3], rng: &mut crate::rules::rng::Stream) {
         let class = self.class_at(from.cell);
         let Some(to) = to else {
-            let (head, p) = self.planes::<u8>();
+            let (head, p) = &mut self.byte_planes();
             put_bit(Cells::new(p.occupancy), from.bit, false);
             head.counters.particles -= 1;
             let (h, table) = head_and_bodies(p.bodies);
@@ -440,7 +440,7 @@ impl World {
         // both widths.
         let width = with_quant!(self.head.desc.quantization, Q => Width::of::<Q>());
         let bytes = if width.wide() { 2 } else { 1 };
-        let (head, p) = self.planes::<u8>();
+        let (head, p) = &mut self.byte_planes();
         let mut v = [0i32; 3];
         for k in 0..dim {
             v[k] = stored(p.velocity, from.cell * dim + k, bytes) << width.fine;

@@ -61,7 +61,7 @@ impl World {
             return if m.to_bits() == self.head.desc.mass.to_bits() { Ok(0) } else { Err(Error::computed(ErrorKind::NotEnabled, || of.not_one())) };
         }
         let used = self.head.masses as usize;
-        let (head, p) = self.planes::<u8>();
+        let (head, p) = &mut self.byte_planes();
         if let Some(i) = p.mass_table[..used].iter().position(|&t| t.to_bits() == m.to_bits()) {
             return Ok(i as u8);
         }
@@ -202,7 +202,7 @@ impl World {
         }
         #[cfg(feature = "identity")]
         {
-            self.planes::<u8>().1.tag[s.cell] = tag;
+            self.byte_planes().1.tag[s.cell] = tag;
         }
         #[cfg(not(feature = "identity"))]
         let _ = tag; // refused above: no world has tags
@@ -216,7 +216,7 @@ impl World {
             return Err(Error::new(ErrorKind::NoParticle, NO_PARTICLE));
         }
         let p = self.particle_at(pos, s.cell);
-        let (head, planes) = self.planes::<u8>();
+        let (head, planes) = &mut self.byte_planes();
         put_bit(Cells::new(planes.occupancy), s.bit, false);
         head.counters.particles -= 1;
         Ok(p)

@@ -26,7 +26,7 @@ impl World {
             });
         }
         let mass_index = self.mass_index_of(e.mass, MassOf::Emitter)?;
-        let (head, p) = self.planes::<u8>();
+        let (head, p) = &mut self.byte_planes();
         p.emitters[used] = Slot { emitter: e, class: u32::from(mass_index), stats: EmitterStats::default() };
         head.emitters += 1;
         Ok(used)
@@ -50,7 +50,7 @@ impl World {
         if index >= self.head.emitters as usize {
             return Err(Error::new(ErrorKind::OutOfBounds, NO_EMITTER));
         }
-        self.planes::<u8>().1.emitters[index].emitter.rate = rate;
+        self.byte_planes().1.emitters[index].emitter.rate = rate;
         Ok(())
     }
 
@@ -63,7 +63,7 @@ impl World {
         if index >= self.head.emitters as usize {
             return Err(Error::new(ErrorKind::OutOfBounds, NO_EMITTER));
         }
-        let slot = &mut self.planes::<u8>().1.emitters[index];
+        let slot = &mut self.byte_planes().1.emitters[index];
         slot.class = u32::from(slot.mass_index()) | u32::from(tag) << 8;
         Ok(())
     }

@@ -59,7 +59,7 @@ impl World {
     /// dense order (x fastest). Needs `forces.field`.
     pub fn set_force_field(&mut self, forces: &[f32]) -> Result<(), Error> {
         self.force_plane_check(self.head.desc.forces.field, forces, self.dim(), Plane::Field)?;
-        self.planes::<u8>().1.field.copy_from_slice(forces);
+        self.byte_planes().1.field.copy_from_slice(forces);
         Ok(())
     }
 
@@ -87,7 +87,7 @@ impl World {
         if wind && !slow(&v[..d]) {
             return Err(Error::new(ErrorKind::SpeedRange, c"wind"));
         }
-        plane(self.planes::<u8>().1)[s.cell * d..s.cell * d + d].copy_from_slice(&v[..d]);
+        plane(self.byte_planes().1)[s.cell * d..s.cell * d + d].copy_from_slice(&v[..d]);
         Ok(())
     }
 
@@ -95,7 +95,7 @@ impl World {
     /// `forces.potential`.
     pub fn set_potential(&mut self, u: &[f32]) -> Result<(), Error> {
         self.force_plane_check(self.head.desc.forces.potential, u, 1, Plane::Potential)?;
-        self.planes::<u8>().1.potential.copy_from_slice(u);
+        self.byte_planes().1.potential.copy_from_slice(u);
         Ok(())
     }
 
@@ -106,7 +106,7 @@ impl World {
             return Err(Error::computed(ErrorKind::NotEnabled, || Plane::Potential.off()));
         }
         finite(&[u], c"potential")?;
-        self.planes::<u8>().1.potential[s.cell] = u;
+        self.byte_planes().1.potential[s.cell] = u;
         Ok(())
     }
 
@@ -120,7 +120,7 @@ impl World {
         if wind.chunks_exact(d).any(|u| !slow(u)) {
             return Err(Error::new(ErrorKind::SpeedRange, c"wind"));
         }
-        self.planes::<u8>().1.wind.copy_from_slice(wind);
+        self.byte_planes().1.wind.copy_from_slice(wind);
         Ok(())
     }
 

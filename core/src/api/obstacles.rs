@@ -268,7 +268,7 @@ impl World {
     /// Inserts or replaces the entry of `entry.cell`; the caller checked that
     /// the table has room.
     fn put_surface(&mut self, entry: Surface) {
-        let (head, p) = self.planes::<u8>();
+        let (head, p) = &mut self.byte_planes();
         let used = head.surfaces as usize;
         match p.surface[..used].binary_search_by_key(&entry.cell, |t| t.cell) {
             Ok(i) => p.surface[i] = entry,
@@ -281,7 +281,7 @@ impl World {
     }
 
     fn drop_surface(&mut self, cell: u32) {
-        let (head, p) = self.planes::<u8>();
+        let (head, p) = &mut self.byte_planes();
         let used = head.surfaces as usize;
         if let Ok(i) = p.surface[..used].binary_search_by_key(&cell, |t| t.cell) {
             p.surface.copy_within(i + 1..used, i);
@@ -315,7 +315,7 @@ impl World {
         // Pass 2: the bits, then the entries, read off the plane as it now is.
         // Nothing here can fail: pass 1 checked every cell.
         a.each(&mut |c| {
-            put_bit(Cells::new(self.planes::<u8>().1.obstacle), site(c).bit, true);
+            put_bit(Cells::new(self.byte_planes().1.obstacle), site(c).bit, true);
             Ok(())
         })?;
         a.each(&mut |c| {

@@ -408,7 +408,7 @@ impl World {
         if Some(count) != self.head.counters.particles.checked_add(c.emitted).and_then(|n| n.checked_sub(c.exited)).and_then(|n| n.checked_sub(c.expired)) {
             return Err(Error::new(ErrorKind::ImageInvalid, c"planes.occupancy does not hold the particles counts says"));
         }
-        let (head, p) = self.planes::<u8>();
+        let (head, p) = &mut self.byte_planes();
         head.ids_given = c.ids_given;
         for (slot, more) in p.emitters.iter_mut().zip(emitters) {
             slot.stats.requested = slot.stats.requested.saturating_add(more.requested);

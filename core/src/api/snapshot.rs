@@ -173,7 +173,19 @@ impl Put<'_> {
     /// A plane of floats. Out of line: one copy serves every plane.
     #[inline(never)]
     fn f32s(&mut self, plane: &[f32]) {
-        plane.iter().for_each(|&f| self.f32(f));
+        let out = &mut self.out[self.at..self.at + 4 * plane.len()];
+        for (o, &f) in out.chunks_exact_mut(4).zip(plane) {
+            o.copy_from_slice(&f.to_bits().to_le_bytes());
+        }
+        self.at += 4 * plane.len();
+    }
+    /// A bit plane, without the bits `clear` has set (none past its end).
+    /// Out of line: one copy for the occupancy and the obstacles.
+    #[inline(never)]
+    fn words(&mut self, plane: &[u64], clear: &[u64]) {
+        for (i, &w) in plane.iter().enumerate() {
+            self.u64(w & !clear.get(i).copied().unwrap_or(0));
+        }
     }
 }
 
@@ -735,6 +747,30 @@ fn read(image: &[u8]) -> Result<Image<'_>, Error> {
     let (width, _) = width_and_scale(desc.quantization);
     let n = particles as usize;
     let dim = desc.dim as usize;
+    // The parts' lengths in the image's order, taken in one loop.
+    let ids = desc.identity;
+    let lens = [
+        layout.occupancy().len,
+        layout.obstacle().len,
+        n * dim * width,
+        if desc.per_particle_mass { n } else { 0 },
+        if desc.lifetimes { 2 * n } else { 0 },
+        if ids.ids() { 4 * n } else { 0 },
+        if ids.ages() { 4 * n } else { 0 },
+        if ids.tags() { n } else { 0 },
+        layout.field().len,
+        layout.potential().len,
+        layout.wind().len,
+        4 * masses,
+        SURFACE * surfaces,
+        emitter_len * emitters,
+        body_bytes(&desc).saturating_sub(BODY_HEAD),
+    ];
+    let mut parts: [&[u8]; 15] = [&[]; 15];
+    for (part, &len) in parts.iter_mut().zip(&lens) {
+        *part = g.take(len)?;
+    }
+    let [occupancy, obstacle, velocity, mass_index, life, id, age, tag, field, potential, wind, mass_table, surface, emitter, body] = parts;
     let img = Image {
         desc,
         layout,
@@ -744,24 +780,24 @@ fn read(image: &[u8]) -> Result<Image<'_>, Error> {
         surfaces,
         emitters,
         emitter_len,
-        occupancy: g.take(layout.occupancy().len)?,
-        obstacle: g.take(layout.obstacle().len)?,
-        velocity: g.take(n * dim * width)?,
-        mass_index: g.take(if desc.per_particle_mass { n } else { 0 })?,
-        life: g.take(if desc.lifetimes { 2 * n } else { 0 })?,
-        id: g.take(if desc.identity.ids() { 4 * n } else { 0 })?,
-        age: g.take(if desc.identity.ages() { 4 * n } else { 0 })?,
-        tag: g.take(if desc.identity.tags() { n } else { 0 })?,
+        occupancy,
+        obstacle,
+        velocity,
+        mass_index,
+        life,
+        id,
+        age,
+        tag,
         ids_given,
-        field: g.take(layout.field().len)?,
-        potential: g.take(layout.potential().len)?,
-        wind: g.take(layout.wind().len)?,
-        mass_table: g.take(4 * masses)?,
-        surface: g.take(SURFACE * surfaces)?,
-        emitter: g.take(emitter_len * emitters)?,
+        field,
+        potential,
+        wind,
+        mass_table,
+        surface,
+        emitter,
         crushed,
         redraws,
-        body: g.take(body_bytes(&desc).saturating_sub(BODY_HEAD))?,
+        body,
     };
     check(&img)?;
     Ok(img)
@@ -772,6 +808,21 @@ fn read(image: &[u8]) -> Result<Image<'_>, Error> {
 #[inline(never)]
 fn finite_plane(plane: &[u8]) -> bool {
     plane.chunks_exact(4).all(|b| f32::from_bits(le_u32(b, 0)).is_finite())
+}
+
+/// Whether every velocity of an image's plane `velocity` of `dim`
+/// components a particle is one the step could have stored (M1). Out of
+/// line, the width a value: one loop for both widths.
+#[inline(never)]
+fn velocities_ok(velocity: &[u8], dim: usize, quantization: Quantization) -> bool {
+    let (width, scale) = width_and_scale(quantization);
+    velocity.chunks_exact(dim * width).all(|v| {
+        let mut q = [0i32; 3];
+        for k in 0..dim {
+            q[k] = component(&v[k * width..], width);
+        }
+        q.iter().all(|c| c.abs() <= scale) && storable(q, scale)
+    })
 }
 
 /// The rules a live world keeps, held against an image's content.
@@ -800,15 +851,8 @@ fn check(img: &Image<'_>) -> Result<(), Error> {
     }
 
     // Velocities the step could have stored (M1), mass classes in use.
-    let (width, scale) = width_and_scale(d.quantization);
-    for v in img.velocity.chunks_exact(dim * width) {
-        let mut q = [0i32; 3];
-        for k in 0..dim {
-            q[k] = component(&v[k * width..], width);
-        }
-        if q.iter().any(|c| c.abs() > scale) || !storable(q, scale) {
-            return bad(c"velocities");
-        }
+    if !velocities_ok(img.velocity, dim, d.quantization) {
+        return bad(c"velocities");
     }
     if img.mass_index.iter().any(|&i| usize::from(i) >= img.masses) {
         return bad(c"mass classes");
@@ -964,7 +1008,7 @@ fn apply(w: &mut World, img: &Image<'_>) {
     // The velocities as bytes, written component by component in the
     // world's width (`store`): one copy of this for both widths.
     {
-        let (_, p) = w.planes::<u8>();
+        let p = &mut w.byte_planes().1;
         for (i, word) in p.occupancy.iter_mut().enumerate() {
             *word = le_u64(img.occupancy, i);
         }
@@ -1011,7 +1055,7 @@ fn apply(w: &mut World, img: &Image<'_>) {
             scatter::<u32>(&l, occupancy, img.age, 1, p.age);
             scatter::<u8>(&l, occupancy, img.tag, 1, p.tag);
         }
-        for (plane, bytes) in [(p.field, img.field), (p.potential, img.potential), (p.wind, img.wind)] {
+        for (plane, bytes) in [(&mut *p.field, img.field), (&mut *p.potential, img.potential), (&mut *p.wind, img.wind)] {
             for (k, f) in plane.iter_mut().enumerate() {
                 *f = f32::from_bits(le_u32(bytes, k));
             }
@@ -1207,14 +1251,10 @@ impl World {
             }
         });
         let occupancy: &[u64] = self.plane(l.occupancy());
-        occupancy.iter().for_each(|&w| p.u64(w));
+        p.words(occupancy, &[]);
         // The static obstacles: bodies are drawn again from their table
         // when the image is loaded (M13).
-        let obstacle: &[u64] = self.plane(l.obstacle());
-        let body = self.body_cells();
-        for (i, &w) in obstacle.iter().enumerate() {
-            p.u64(w & !body.get(i).copied().unwrap_or(0));
-        }
+        p.words(self.plane(l.obstacle()), self.body_cells());
         // Per particle, in cell order: velocities, mass classes, lifetimes,
         // then ids, ages and tags. The velocities as stored: an 8-bit
         // component is its byte, a 16-bit one its two.
@@ -1275,7 +1315,7 @@ impl World {
     /// build left out (`Dim3Disabled`, `Q16Disabled`, `FeatureDisabled`).
     pub fn load(&mut self, image: &[u8]) -> Result<(), Error> {
         let img = read(image)?;
-        if img.layout != self.head.layout {
+        if !img.layout.same(&self.head.layout) {
             return Err(Error::computed(ErrorKind::ImageMismatch, || mismatch(&img.desc, &self.head.desc)));
         }
         apply(self, &img);

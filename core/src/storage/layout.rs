@@ -136,6 +136,25 @@ pub(crate) struct Layout {
     pub total: usize,
 }
 
+// `Layout::same` reads a layout as words: it must be usizes alone.
+const _: () = assert!(size_of::<Layout>() == (7 + 2 * PLANES) * size_of::<usize>());
+
+impl Layout {
+    /// Whether `other` is the same plan: compared as words in one
+    /// comparison of memory, not field by field, which the compiler
+    /// unrolls into a compare and branch for every one of them.
+    pub(crate) fn same(&self, other: &Layout) -> bool {
+        self.as_usizes() == other.as_usizes()
+    }
+
+    fn as_usizes(&self) -> &[usize] {
+        // SAFETY: a Layout is only usizes (sizes, counts and planes of two
+        // of them, as the assertion above checks), so it has no padding and
+        // is read in place as that many aligned usizes, borrowed as `self`.
+        unsafe { core::slice::from_raw_parts((self as *const Layout).cast::<usize>(), size_of::<Layout>() / size_of::<usize>()) }
+    }
+}
+
 /// The planes every build plans, the getters of `planes!` below.
 const BASE_PLANES: usize = 13;
 /// The identity planes (M6b), after the base ones, only in a build with

@@ -286,6 +286,17 @@ impl World {
         (head, planes)
     }
 
+    /// The planes with the velocities as bytes, as [`World::split`] hands
+    /// them back: for the API's calls outside the step, which take them
+    /// so. Not through [`World::planes`], whose move of every plane into a
+    /// new `Planes` each of its inlined callers would hold; callers borrow
+    /// the result where it lies (`&mut self.byte_planes()`) for the same
+    /// reason, as taking it apart moves every plane again.
+    #[inline]
+    pub(crate) fn byte_planes(&mut self) -> (&mut Header, Planes<'_, u8>) {
+        self.split::<u8>()
+    }
+
     /// [`World::planes`]' split of the memory.
     #[cfg_attr(not(feature = "small-step"), inline(never))]
     fn split<Q: Plain>(&mut self) -> (&mut Header, Planes<'_, Q>) {
