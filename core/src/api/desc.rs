@@ -382,8 +382,8 @@ impl Description {
                 d.gravity = [0.0, 0.0069, 0.0];
                 d.drag.rate = 0.033;
                 // Eddies of 16 cells that break the column up: each
-                // component of their flow up to 0.3 cells a step, above
-                // the rise, a new flow every 100 steps.
+                // component of their flow up to 0.5 cells a step, above
+                // the rise, a new flow every 50 steps.
                 d.drag.turbulence = Turbulence { amplitude: 0.5, scale: 16, rate: 0.02 };
                 d.collisions = Collisions::SpeedLimited;
                 d.contacts = false;
@@ -466,7 +466,7 @@ impl Description {
         finite(&[self.drag.rate], c"desc.drag.rate")?;
         finite(&self.drag.wind, c"desc.drag.wind")?;
         if negative(self.drag.rate) {
-            return Err(Error::new(ErrorKind::BadDrag, c"desc.drag.rate"));
+            return Err(Error::new(K::BadDrag, c"desc.drag.rate"));
         }
         if !crate::api::speed::slow(&self.drag.wind[..dim]) {
             return Err(Error::new(K::SpeedRange, c"desc.drag.wind"));
