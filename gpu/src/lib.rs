@@ -183,13 +183,12 @@ pub fn unsupported(d: &Description) -> Option<&'static str> {
 /// What [`unsupported`] names, and the detail of the refusal: the field
 /// that asks for it.
 fn refusal(d: &Description) -> Option<(&'static CStr, &'static str)> {
-    let checks: [(bool, &'static CStr, &'static str); 3] = [
+    let checks: [(bool, &'static CStr, &'static str); 2] = [
         // Correct where loops are not limited, but a dense 3D block's search
         // (8! leaves) runs past the loop limit of Mesa's lavapipe, which
         // ends a shader's loops after 65,535 iterations in all: untested.
         (d.dim == 2 || d.method != Method::Exhaustive, c"desc.method: exhaustive assignment in 3D", "exhaustive assignment in 3D"),
         (!(d.obstacles && d.body_capacity > 0), c"desc.body_capacity: bodies, obstacles the caller moves (M13)", "bodies, obstacles the caller moves (M13)"),
-        (!d.rest, c"desc.rest: resting contact (M5.7b)", "resting contact (M5.7b)"),
     ];
     checks.iter().find(|(ok, ..)| !ok).map(|&(_, detail, part)| (detail, part))
 }
@@ -644,7 +643,7 @@ fn counters_of(host: &World) -> [u32; COUNTERS] {
 }
 
 /// The shader's parameters (`rule.wgsl`).
-const PARAMS: usize = 62;
+const PARAMS: usize = 67;
 
 /// A face as the shader reads it: 0 periodic, 1 wall, 2 open.
 fn face(b: Boundary) -> u32 {
@@ -668,6 +667,7 @@ fn params(c: &StepConstants, d: &Description, d_emitters: u32, surfaces: u32) ->
     let flow = v.flow.unwrap_or_default();
     let drag = c.drag.unwrap_or(DragConstants { keep: 0, wind: [0; 3], field: false, turbulence: None });
     let eddies = drag.turbulence.unwrap_or(TurbulenceConstants { rate: 0, base: 0, t: 0, shift: 0, lambda: 0 });
+    let rest = c.rest;
     let on = |x: bool| u32::from(x);
     [
         lo(d.seed),
@@ -732,5 +732,10 @@ fn params(c: &StepConstants, d: &Description, d_emitters: u32, surfaces: u32) ->
         eddies.t as u32,
         eddies.shift as u32,
         eddies.lambda,
+        on(rest.is_some()),
+        rest.map_or(0, |r| r.axis),
+        on(rest.is_some_and(|r| r.up)),
+        rest.map_or(0, |r| r.lower),
+        rest.map_or(0, |r| r.slow as u32),
     ]
 }

@@ -35,7 +35,9 @@
 // obstacles, 51 energy-neutral rounding (M1b), 52 masses, 53 M6b's planes,
 // 54 M5.6's method (0 exhaustive, 1 exact-fast, 2 greedy), 55 turbulence
 // (M5.1c) in the flow, 56 its R (Q16), 57-58 its β (64-bit pair), 59 its
-// t, 60 its shift e - 30 (i32), 61 its log2(scale). 3-5, 13, 33-34
+// t, 60 its shift e - 30 (i32), 61 its log2(scale), 62 resting contact
+// (M5.7b), 63 its support axis, 64 whether G points up it, 65 the lower
+// half's cells, 66 its T (fine units). 3-5, 13, 33-34
 // and 37 are 0: what depends on the mass (K, the clamp's energy factor,
 // the vortex force's strength) is in `classes`, per mass index.
 @group(0) @binding(0) var<storage, read> params: array<u32>;
@@ -1016,16 +1018,112 @@ fn collide(xa: vec3<i32>, xc: vec3<i32>, ca: u32, cc: u32, out: ptr<function, ar
     return true;
 }
 
-// M5.1 on every particle (where a force is on), M5.1b, M5.2 on the block's
-// pair, then M1 for every velocity they changed, in cell order.
-fn change(b: ptr<function, Block>, at: array<vec3<u32>, CELLS>, s: ptr<function, Stream>, counts: ptr<function, Counts>) {
+// ---- M5.7b: resting contact ---------------------------------------------
+
+// What a block's particles rest on: whether the support holds, what a fast
+// particle of the upper half does there (0 left to M5.4, 1 reflects, 2
+// stops) and the particles that rest.
+struct Resting {
+    held: bool,
+    fast: u32,
+    cells: u32,
+}
+
+// A component along the support axis, positive into the support.
+fn into_support(x: i32) -> i32 {
+    return select(-x, x, params[64] != 0u);
+}
+
+// Which particles of the block rest, from their stored velocities, and
+// whether its lower half is all walls, obstacles (`blocked`) or particles.
+fn resting_of(b: ptr<function, Block>, blocked: u32) -> Resting {
+    let axis = params[63];
+    let lower = params[65];
+    let occ = (*b).occ;
+    var still = 0u;
+    var falling = 0u;
+    for (var c = 0u; c < CELLS; c++) {
+        if (occ >> c & 1u) != 0u {
+            let q = (*b).v[c];
+            still |= select(0u, 1u, all(q == vec3<i32>(0))) << c;
+            falling |= select(0u, 1u, into_support(q[axis]) > 0) << c;
+        }
+    }
+    let held = (lower & ~(blocked | occ)) == 0u;
+    let upper = ~lower & ((1u << CELLS) - 1u);
+    var fast = 2u;
+    if (lower & occ) == 0u {
+        fast = 0u;
+    } else if (upper & ~(occ | blocked)) != 0u {
+        fast = 1u;
+    }
+    let on = held && (lower & falling) == 0u;
+    return Resting(held, fast, still & select(lower, 0xffu, on));
+}
+
+// M5.7b's second step where the support holds: each particle of the upper
+// half coming into it slowly (or caged) takes the support's speed, and
+// what little it slides across too; one coming fast with room above
+// reflects with e; against walls and obstacles alone it is left to M5.4.
+fn settle(b: ptr<function, Block>, x: ptr<function, array<vec3<i32>, CELLS>>, changed: ptr<function, u32>, r: Resting) {
+    let axis = params[63];
+    let lower = params[65];
+    let slow = params[66];
+    let occ = (*b).occ;
+    var floor = 0x7fffffff;
+    for (var c = 0u; c < CELLS; c++) {
+        if (lower >> c & 1u) != 0u {
+            var away = 0;
+            if (occ >> c & 1u) != 0u {
+                away = into_support((*x)[c][axis]);
+            }
+            floor = min(floor, max(away, 0));
+        }
+    }
+    for (var c = 0u; c < CELLS; c++) {
+        if (occ >> c & 1u) == 0u || (lower >> c & 1u) != 0u {
+            continue;
+        }
+        var y = (*x)[c];
+        let closing = into_support(y[axis]) - floor;
+        var after = floor;
+        if u32(abs(closing)) <= slow {
+            for (var k = 0u; k < DIM; k++) {
+                if k != axis && u32(abs(y[k])) <= slow {
+                    y[k] = 0;
+                }
+            }
+        } else if closing < 0 || r.fast == 0u {
+            continue;
+        } else if r.fast == 1u {
+            after = floor - mulq(closing, bitcast<i32>(params[10]), 16u);
+        }
+        y[axis] = into_support(after);
+        (*x)[c] = y;
+        *changed |= 1u << c;
+    }
+}
+
+// M5.1 on every particle (where a force is on; less the uniform push for a
+// particle at rest, M5.7b), M5.1b, M5.7b, M5.2 on the block's pair, then
+// M1 for every velocity they changed, in cell order.
+fn change(b: ptr<function, Block>, at: array<vec3<u32>, CELLS>, blocked: u32, s: ptr<function, Stream>, counts: ptr<function, Counts>) {
     var x: array<vec3<i32>, CELLS>;
     var changed = 0u;
+    var resting = Resting(false, 0u, 0u);
+    if params[62] != 0u {
+        resting = resting_of(b, blocked);
+    }
     for (var c = 0u; c < CELLS; c++) {
         x[c] = (*b).v[c] << vec3<u32>(fine());
         if params[22] != 0u && ((*b).occ >> c & 1u) != 0u {
             // A push of exactly zero touches nothing (M5.1).
-            let dv = push_at(at[c], (*b).mass[c]);
+            var dv = push_at(at[c], (*b).mass[c]);
+            if (resting.cells >> c & 1u) != 0u {
+                for (var k = 0u; k < 3u; k++) {
+                    dv[k] = sub64(dv[k], vec2<u32>(params[16u + 2u * k], params[17u + 2u * k]));
+                }
+            }
             if !is_zero64(dv[0] | dv[1] | dv[2]) {
                 x[c] = clamp_speed(pushed(x[c], dv), (*b).mass[c], counts);
                 changed |= 1u << c;
@@ -1049,6 +1147,9 @@ fn change(b: ptr<function, Block>, at: array<vec3<u32>, CELLS>, s: ptr<function,
             x[c] = clamp_speed(y, (*b).mass[c], counts);
             changed |= 1u << c;
         }
+    }
+    if params[62] != 0u && resting.held {
+        settle(b, &x, &changed, resting);
     }
     // M5.2's pair, the block's first draw.
     if ((*b).occ & ((*b).occ - 1u)) != 0u {
@@ -1686,7 +1787,7 @@ fn sweep(@builtin(global_invocation_id) id: vec3<u32>) {
         var block_counts = Counts(0u, 0u, vec2<u32>(0u, 0u), false, 0u, 1u, 0u, 0u);
         let index = u32(bx) + blocks.x * r;
         var s = stream_of(sk, index);
-        change(&b, site.at, &s, &block_counts);
+        change(&b, site.at, site.blocked, &s, &block_counts);
         let want = desire(&b, &site, &s, &block_counts);
         let targets = assign(&b, site.blocked, want, &s, &block_counts);
         if params[26] != 0u && want != 0u {

@@ -144,10 +144,67 @@ fn a_part_the_backend_does_not_run_is_refused() {
     let w = WorldBox::new(&d).unwrap();
     assert_eq!(refused(&w), Some((mpca::ErrorKind::FeatureDisabled, "desc.body_capacity: bodies, obstacles the caller moves (M13)")));
     assert_eq!(mpca_gpu::unsupported(w.description()), Some("bodies, obstacles the caller moves (M13)"));
-    let mut d = Description::new_2d(16, 16);
-    d.rest = true;
-    let w = WorldBox::new(&d).unwrap();
-    assert_eq!(refused(&w), Some((mpca::ErrorKind::FeatureDisabled, "desc.rest: resting contact (M5.7b)")));
+}
+
+/// A box with walls of `size` cells (2D where the third is 1) under
+/// gravity 0.02 down y, with restitution `e` for particles and walls,
+/// contacts and resting contact (M5.7b), and `rows` full rows of still
+/// particles from 12 cells up, as the pile of `tests/tests/rest.rs`.
+fn pile(size: [u32; 3], e: f32, rows: u32, seed: u64) -> WorldBox {
+    let mut d = if size[2] == 1 { Description::new_2d(size[0], size[1]) } else { Description::new_3d(size[0], size[1], size[2]) };
+    d = d.with_boundary(mpca::Boundary::Wall);
+    d.forces.uniform = true;
+    d.gravity = [0.0, -0.02, 0.0];
+    (d.restitution, d.wall_restitution) = (e, e);
+    (d.contacts, d.rest) = (true, true);
+    d.seed = seed;
+    let mut w = WorldBox::new(&d).unwrap();
+    for z in 0..size[2] {
+        for y in 12..12 + rows {
+            for x in 0..size[0] {
+                w.add_particle([x, y, z], [0.0; 3]).unwrap();
+            }
+        }
+    }
+    w
+}
+
+#[test]
+fn resting_contact_steps_as_on_the_cpu() {
+    // M5.7b: 8 rows dropped 12 cells onto the floor, at e = 0 and 0.5 (the
+    // fall, the impacts, the pile coming to rest and resting), 2D for 600
+    // steps compared every 20; 3D (4 rows, 16 x 24 x 6) for 300 steps.
+    for e in [0.0, 0.5] {
+        let mut w = pile([64, 48, 1], e, 8, 11);
+        same_worlds(&mut w, 600, 20);
+        let mut w = pile([16, 24, 6], e, 4, 12);
+        same_worlds(&mut w, 300, 20);
+    }
+}
+
+#[test]
+fn a_pour_onto_a_resting_pool_steps_as_on_the_cpu() {
+    // M5.7b with everything round it: the water preset, an emitter pouring
+    // onto a pool at rest, obstacles (a disc), gravity, contacts.
+    let mut d = Description::preset(mpca::Preset::Water, 2, [48, 48, 1]);
+    d.obstacles = true;
+    d.surface_capacity = 128;
+    d.emitter_capacity = 1;
+    d.seed = 21;
+    let mut w = WorldBox::new(&d).unwrap();
+    w.add_shape(mpca::Shape::Disc { centre: [30.0, 10.0], radius: 5.0 }, 0.95).unwrap();
+    for y in 0..4 {
+        for x in 0..48 {
+            match w.add_particle([x, y, 0], [0.0; 3]) {
+                Ok(()) => {}
+                Err(e) if e.kind() == mpca::ErrorKind::CellObstacle => {}
+                Err(e) => panic!("{e:?}"),
+            }
+        }
+    }
+    let pour = mpca::Emitter { min: [10, 40, 0], max: [16, 44, 1], rate: 1.0, velocity: [0.1, -0.3, 0.0], spread: 0.1, mass: 1.0, lifetime: 0 };
+    w.add_emitter(pour).unwrap();
+    same_worlds(&mut w, 400, 20);
 }
 
 #[test]

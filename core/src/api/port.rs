@@ -22,6 +22,8 @@ use crate::step::partition::Partition;
 use crate::storage::layout::stored;
 use crate::api::checks::positive;
 pub use crate::rules::turbulence::TurbulenceConstants;
+pub use crate::step::rest::RestConstants;
+use crate::step::rest::Support;
 use crate::storage::world::{Counters, World};
 
 /// The integers one step of a world reads, converted from its description
@@ -51,6 +53,9 @@ pub struct StepConstants {
     pub vortex: Option<VortexConstants>,
     /// M5.1b's drag, where its rate is not 0.
     pub drag: Option<DragConstants>,
+    /// M5.7b's support, where resting contact is on and the uniform push
+    /// is not 0.
+    pub rest: Option<RestConstants>,
 }
 
 /// M5.1's vortex as the step reads it (M1c): its centre and core radius
@@ -203,8 +208,9 @@ impl World {
         let desc = &self.head.desc;
         let unit = unit_of(desc.quantization);
         let (s, fine) = unit_scale(unit);
+        let push = if desc.forces.uniform { desc.gravity.map(|g| scaled_by(desc.dt, g, s, fine)) } else { [0; 3] };
         StepConstants {
-            push: if desc.forces.uniform { desc.gravity.map(|g| scaled_by(desc.dt, g, s, fine)) } else { [0; 3] },
+            push,
             restitution: scaled(desc.restitution, 1.0, 16) as i32,
             wall_restitution: scaled(desc.wall_restitution, 1.0, 16) as i32,
             speed_limit: unit - csqrt(u64::from(desc.dim) << (2 * fine), 1 << fine) as i32,
@@ -228,6 +234,7 @@ impl World {
                 turbulence: positive(desc.drag.turbulence.amplitude)
                     .then(|| TurbulenceConstants::of(&desc.drag.turbulence, desc.seed, desc.dim as usize, (s, fine))),
             }),
+            rest: if desc.has_rest() { Support::of(push, desc.dim as usize, fine as u32).map(|s| s.constants()) } else { None },
         }
     }
 

@@ -45,6 +45,22 @@ pub(crate) enum Fast {
     Stop,
 }
 
+/// M5.7b's support as every step reads it (M1c), for a second
+/// implementation (`mpca::port`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RestConstants {
+    /// The support axis: that of the largest `|G_k|`, the lowest on a tie.
+    pub axis: u32,
+    /// Whether `G` points to the axis' high side.
+    pub up: bool,
+    /// The block's cells on the side `G` points to (its lower half), a bit
+    /// a cell.
+    pub lower: u32,
+    /// `T`: the fastest approach along the axis that is a resting contact
+    /// (fine units).
+    pub slow: i32,
+}
+
 impl Resting {
     /// A block where nothing rests: a world without M5.7b.
     pub(crate) const NONE: Resting = Resting { held: false, fast: Fast::Leave, cells: 0 };
@@ -73,6 +89,11 @@ impl Support {
         // rest, after its lower-half step and its upper-half one.
         let slow = (2 * g[axis].unsigned_abs().min(1 << 40) + (1 << fine)).min(i32::MAX as u64) as i32;
         Some(Support { axis, up, lower, slow })
+    }
+
+    /// The support as a second implementation reads it.
+    pub(crate) fn constants(&self) -> RestConstants {
+        RestConstants { axis: self.axis as u32, up: self.up, lower: u32::from(self.lower), slow: self.slow }
     }
 
     /// Which particles of the block `b` rest, and whether its support
