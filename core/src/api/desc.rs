@@ -381,9 +381,9 @@ impl Description {
                 d.boundary[1][0] = Boundary::Wall;
                 d.gravity = [0.0, 0.0069, 0.0];
                 d.drag.rate = 0.033;
-                // Eddies of 16 cells that break the column up: each
-                // component of their flow up to 0.5 cells a step, above
-                // the rise, a new flow every 50 steps.
+                // Eddies faster than the rise, changing about once a
+                // second at the units' 60 steps a second, so that the
+                // column wavers and breaks up (docs/model.md, Presets).
                 d.drag.turbulence = Turbulence { amplitude: 0.5, scale: 16, rate: 0.02 };
                 d.collisions = Collisions::SpeedLimited;
                 d.contacts = false;
@@ -513,10 +513,11 @@ impl Description {
         }
         let t = &self.drag.turbulence;
         finite(&[t.amplitude, t.rate], c"desc.drag.turbulence")?;
-        if !positive(t.amplitude) {
-            return if negative(t.amplitude) { Err(Error::new(ErrorKind::BadDrag, c"desc.drag.turbulence.amplitude (0 to 1)")) } else { Ok(()) };
+        // 0 (or -0) is off.
+        if !positive(t.amplitude) && !negative(t.amplitude) {
+            return Ok(());
         }
-        let problem = if size(t.amplitude) > size(1.0) {
+        let problem = if negative(t.amplitude) || size(t.amplitude) > size(1.0) {
             c"desc.drag.turbulence.amplitude (0 to 1)"
         } else if !t.scale.is_power_of_two() || t.scale > 1024 {
             c"desc.drag.turbulence.scale (a power of two, 1 to 1024)"

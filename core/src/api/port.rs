@@ -20,7 +20,6 @@ use crate::rules::quant::unit_of;
 use crate::step::convert_class;
 use crate::step::partition::Partition;
 use crate::storage::layout::stored;
-use crate::api::checks::positive;
 pub use crate::rules::turbulence::TurbulenceConstants;
 pub use crate::step::rest::RestConstants;
 use crate::step::rest::Support;
@@ -231,10 +230,9 @@ impl World {
                 keep: divr(1 << 48, (1 << 32) + scaled(desc.dt, desc.drag.rate, 32) as u64) as i32,
                 wind: desc.drag.wind.map(|u| to_fine(u, (s, fine))),
                 field: desc.drag.field,
-                turbulence: positive(desc.drag.turbulence.amplitude)
-                    .then(|| TurbulenceConstants::of(&desc.drag.turbulence, desc.seed, desc.dim as usize, (s, fine))),
+                turbulence: TurbulenceConstants::of(desc, (s, fine)),
             }),
-            rest: if desc.has_rest() { Support::of(push, desc.dim as usize, fine as u32).map(|s| s.constants()) } else { None },
+            rest: Support::of(desc, push, fine as u32).map(|s| s.constants()),
         }
     }
 

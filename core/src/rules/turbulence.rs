@@ -3,6 +3,9 @@
 //! (a shader has no wider ones); the settings are converted once a world
 //! ([`TurbulenceConstants`]), the time slices once a step ([`Eddies`]).
 
+use crate::api::checks::positive;
+use crate::api::desc::Description;
+#[cfg(test)]
 use crate::api::desc::Turbulence;
 use crate::rules::fixed::{divr, scaled, scaled_by};
 use crate::rules::rng::mix;
@@ -14,24 +17,19 @@ const DOMAIN: u64 = 0x6d70_6361_7472_6200;
 /// multiplied by its own odd constant before the hash.
 const SPREAD: [u32; 4] = [0x9e37_79b9, 0xbf58_476d, 0x94d0_49bb, 0xa076_1d65];
 
-/// The turbulence of one step, converted (M5.1c's integers). Small: the
-/// step's shared data holds it beside everything else.
+/// The turbulence of one step (M5.1c's integers): the world's settings and
+/// this step's time slices.
 #[derive(Clone, Copy)]
 pub(crate) struct Eddies {
+    c: TurbulenceConstants,
     /// The two time slices' keys, `κ_0` and `κ_1`.
     keys: [u32; 2],
+    /// The weight of the second slice, `w_t`, in Q15.
+    time: u32,
     /// Per axis, its size in cells where it is periodic (the corner after
     /// its last cell is its first), or 0.
     wrap: [u32; 3],
-    /// The weight of the second slice, `w_t`, in Q15.
-    time: u16,
-    /// `T`'s top 12 bits.
-    t: i16,
-    /// The shift `e - 30` that scales `d t` to fine units.
-    shift: i8,
-    /// `log2(scale)`.
-    lambda: u8,
-    dim: u8,
+    dim: usize,
 }
 
 /// M5.1c's `h32`: every bit of the word mixed into every other.
@@ -73,22 +71,26 @@ pub struct TurbulenceConstants {
 }
 
 impl TurbulenceConstants {
-    /// The turbulence `t` of a `dim`-dimensional world of seed `seed`, for
-    /// the unit speed `(s, fine)` (M1c). [`Description::check`](crate::Description)
-    /// has checked `t`.
-    pub(crate) fn of(t: &Turbulence, seed: u64, dim: usize, (s, fine): (u32, i32)) -> TurbulenceConstants {
+    /// The turbulence of a world of description `d`, for the unit speed
+    /// `(s, fine)` (M1c); none where its amplitude is not above 0.
+    /// [`Description::check`] has checked the settings.
+    pub(crate) fn of(d: &Description, (s, fine): (u32, i32)) -> Option<TurbulenceConstants> {
+        let t = &d.drag.turbulence;
+        if !positive(t.amplitude) {
+            return None;
+        }
         // The scale of a unit `d`, `a W scale / (3 2^16 q)` in units of
         // 2^-30, and its top 12 bits.
-        let q_bits = if dim == 3 { 2 } else { 0 };
+        let q_bits = if d.dim == 3 { 2 } else { 0 };
         let big = divr(scaled_by(t.amplitude, t.scale as f32, s, fine + 14 - q_bits) as u64, 3);
         let bits = 64 - big.leading_zeros() as i32;
-        TurbulenceConstants {
+        Some(TurbulenceConstants {
             rate: scaled(t.rate, 1.0, 16) as u32,
-            base: mix(seed ^ DOMAIN),
+            base: mix(d.seed ^ DOMAIN),
             t: if bits > 12 { big >> (bits - 12) } else { big << (12 - bits) } as i32,
             shift: bits - 12 - 30,
             lambda: t.scale.trailing_zeros(),
-        }
+        })
     }
 }
 
@@ -96,17 +98,15 @@ impl Eddies {
     /// The turbulence of step `step` in a world of `dim` axes of `n` cells
     /// (`periodic` where they wrap) whose settings are `c`: the two time
     /// slices' keys and the weight between them.
-    pub(crate) fn of(c: &TurbulenceConstants, step: u64, dim: usize, n: [usize; 3], periodic: [bool; 3]) -> Eddies {
+    pub(crate) fn of(c: TurbulenceConstants, step: u64, dim: usize, n: [usize; 3], periodic: [bool; 3]) -> Eddies {
         let phase = step.wrapping_mul(u64::from(c.rate));
         let slice = phase >> 16;
         Eddies {
+            c,
             keys: [0, 1].map(|j| mix(c.base ^ slice.wrapping_add(j)) as u32),
+            time: smooth((phase & 0xffff) as u32 >> 1),
             wrap: [0, 1, 2].map(|k| if periodic[k] { n[k] as u32 } else { 0 }),
-            time: smooth((phase & 0xffff) as u32 >> 1) as u16,
-            t: c.t as i16,
-            shift: c.shift.clamp(-64, 63) as i8,
-            lambda: c.lambda as u8,
-            dim: dim as u8,
+            dim,
         }
     }
 
@@ -116,7 +116,7 @@ impl Eddies {
     /// call.
     #[inline(never)]
     pub(crate) fn at(&self, pos: [usize; 3]) -> [i64; 3] {
-        let dim = usize::from(self.dim);
+        let dim = self.dim;
         let mut d = [0i32; 3];
         for m in 0..1usize << dim {
             let mut corner = [0u32; 3];
@@ -143,7 +143,7 @@ impl Eddies {
         }
         let mut u = [0i64; 3];
         for k in 0..dim {
-            let (y, shift) = (d[k] * i32::from(self.t), i32::from(self.shift));
+            let (y, shift) = (d[k] * self.c.t, self.c.shift);
             u[k] = i64::from(if shift >= 0 { y << shift } else { y >> (-shift).min(31) });
         }
         u
@@ -154,7 +154,7 @@ impl Eddies {
     /// the two slices blended. Out of line: called from one loop.
     #[inline(never)]
     fn potential(&self, corner: [u32; 3], c: u32) -> i32 {
-        let (dim, lambda) = (usize::from(self.dim), u32::from(self.lambda));
+        let (dim, lambda) = (self.dim, self.c.lambda);
         let mut points = [[0u32; 2]; 3];
         let mut w = [0u32; 3];
         for k in 0..dim {
@@ -188,13 +188,13 @@ impl Eddies {
                 }
             }
         }
-        lerp(slices[0], slices[1], u32::from(self.time))
+        lerp(slices[0], slices[1], self.time)
     }
 
     /// `d` unscaled at `pos`, for the tests of its divergence.
     #[cfg(test)]
     fn unscaled(&self, pos: [usize; 3]) -> [i32; 3] {
-        let scaled = Eddies { t: 1, shift: 0, ..*self };
+        let scaled = Eddies { c: TurbulenceConstants { t: 1, shift: 0, ..self.c }, ..*self };
         scaled.at(pos).map(|x| x as i32)
     }
 }
@@ -204,8 +204,10 @@ mod tests {
     use super::*;
 
     fn eddies(dim: usize, scale: u32, n: [usize; 3], periodic: [bool; 3], step: u64) -> Eddies {
-        let t = Turbulence { amplitude: 0.3, scale, rate: 0.05 };
-        Eddies::of(&TurbulenceConstants::of(&t, 7, dim, (127, 16)), step, dim, n, periodic)
+        let mut d = Description::new_3d(1, 1, 1);
+        (d.dim, d.seed) = (dim as u32, 7);
+        d.drag.turbulence = Turbulence { amplitude: 0.3, scale, rate: 0.05 };
+        Eddies::of(TurbulenceConstants::of(&d, (127, 16)).unwrap(), step, dim, n, periodic)
     }
 
     /// M5.1c: over the cells round every corner inside the grid (and, on

@@ -33,7 +33,6 @@ pub(crate) mod tasks;
 use crate::rules::fixed::{divr, magnitude, quot, scaled, scaled_by, to_fine, unit_scale};
 use crate::rules::force::{Flow, ForceTerms, Strength, Swirl};
 use crate::rules::turbulence::{Eddies, TurbulenceConstants};
-use crate::api::checks::positive;
 use crate::rules::quant::{Quant, Width};
 use crate::rules::rng::StepKey;
 use crate::rules::class::Class;
@@ -311,7 +310,7 @@ impl World {
             push: pushes.then_some(push),
             lean_push: if lean && small_push && pushes { Some(push.map(|g| g as i32)) } else { None },
             restitution: scaled(desc.restitution, 1.0, 16) as i32,
-            rest: if desc.has_rest() { Support::of(push, dim, fine as u32) } else { None },
+            rest: Support::of(desc, push, fine as u32),
             terms,
             drag: desc.has_drag().then(|| Flow {
                 wind: desc.drag.wind.map(|u| to_fine(u, (s, fine))),
@@ -324,10 +323,7 @@ impl World {
                 unit: (s, fine),
                 dim,
                 keep: divr(1 << 48, (1 << 32) + scaled(desc.dt, desc.drag.rate, 32) as u64) as i32,
-                turbulence: positive(desc.drag.turbulence.amplitude).then(|| {
-                    let c = TurbulenceConstants::of(&desc.drag.turbulence, desc.seed, dim, (s, fine));
-                    Eddies::of(&c, head.step, dim, n, periodic)
-                }),
+                turbulence: TurbulenceConstants::of(desc, (s, fine)).map(|c| Eddies::of(c, head.step, dim, n, periodic)),
             }),
             moves: crate::rules::quant::move_table_8(desc.drift),
             #[cfg(not(feature = "small-step"))]

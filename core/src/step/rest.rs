@@ -2,6 +2,7 @@
 //! no push from the uniform force and loses its velocity into the support
 //! along it, so a pool or a pile comes exactly to rest. Draws nothing.
 
+use crate::api::desc::Description;
 use crate::rules::fixed::mulq;
 use crate::step::block::{cells_of, Stored};
 use crate::step::rounding::Changes;
@@ -68,9 +69,13 @@ impl Resting {
 
 impl Support {
     /// The support of a step whose uniform push is `g` (fine units of
-    /// `2^-fine` quanta), in a world of dimension `dim`; none where the
-    /// push is zero.
-    pub(crate) fn of(g: [i64; 3], dim: usize, fine: u32) -> Option<Support> {
+    /// `2^-fine` quanta) in a world of description `d`; none where resting
+    /// contact is off or the push is zero.
+    pub(crate) fn of(d: &Description, g: [i64; 3], fine: u32) -> Option<Support> {
+        if !d.has_rest() {
+            return None;
+        }
+        let dim = d.dim as usize;
         let mut axis = 0;
         for k in 1..dim {
             if g[k].unsigned_abs() > g[axis].unsigned_abs() {

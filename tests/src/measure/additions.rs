@@ -76,19 +76,17 @@ fn step_and_read(w: &mut World, steps: u64) -> (Ended, f64) {
     (ended, seconds)
 }
 
-/// A figure of a run: its name and how it is read.
-type Figure = (&'static str, fn(&Ended) -> f64);
+/// A figure of a run that ends with a `T`: its name and how it is read.
+type Figure<T> = (&'static str, fn(&T) -> f64);
 
-/// A figure of a plume (M5.1c), likewise.
-type PlumeFigure = (&'static str, fn(&plume::Plume) -> f64);
-
-/// The figures `figures` of the pair of runs `(paper, addition)`.
-fn rows(
+/// The figures `figures` of the pair of runs `(paper, addition)`, whatever
+/// a run ends with (`T`).
+fn rows<T>(
     rule: &'static str,
     scenes: String,
-    figures: &[Figure],
-    paper: (Ended, Timing),
-    addition: (Ended, Timing),
+    figures: &[Figure<T>],
+    paper: (T, Timing),
+    addition: (T, Timing),
     steps: (u64, u64),
 ) -> Vec<AdditionRow> {
     figures
@@ -125,7 +123,7 @@ pub fn measure(share: f64, box_steps: u64, runs: usize) -> Vec<AdditionRow> {
     // M5.1b: the paper's vortex force against drag towards the flow.
     let (smoke, flow) = (scenes::smoke(), scenes::smoke_flow());
     let (a, b) = (steps(480), steps(flow.steps));
-    out.extend(rows(
+    out.extend(rows::<Ended>(
         "M5.1b flow drag",
         format!("{} / {}", smoke.name, flow.name),
         &[("clamps per particle-step", |e| e.clamps_per_particle_step), ("mean speed at the end", |e| e.mean_speed)],
@@ -143,24 +141,13 @@ pub fn measure(share: f64, box_steps: u64, runs: usize) -> Vec<AdditionRow> {
         repeat(runs, || plume::measure(&scene))
     };
     let (calm_run, stirred_run) = (plume_run(&calm), plume_run(&stirred));
-    let figures: [PlumeFigure; 4] = [
+    let figures: [Figure<plume::Plume>; 4] = [
         ("plume width 8 to 24 cells up, cells", |p| p.width[0]),
         ("plume width 104 to 120 cells up, cells", |p| p.width[3]),
         ("r.m.s. sideways velocity", |p| p.sideways),
         ("clamps per particle-step", |p| p.clamps),
     ];
-    for (measure, f) in figures {
-        out.push(AdditionRow {
-            rule: "M5.1c turbulence",
-            scenes: "plume of the smoke preset, 128²".into(),
-            measure,
-            paper: f(&calm_run.0),
-            addition: f(&stirred_run.0),
-            steps: (n, n),
-            paper_timing: calm_run.1.clone(),
-            addition_timing: stirred_run.1.clone(),
-        });
-    }
+    out.extend(rows("M5.1c turbulence", "plume of the smoke preset, 128²".into(), &figures, calm_run, stirred_run, (n, n)));
 
     // M5.2b: the e = 1 cluster collision, paper collisions against
     // speed-limited ones.
@@ -168,7 +155,7 @@ pub fn measure(share: f64, box_steps: u64, runs: usize) -> Vec<AdditionRow> {
     let mut limited = scenes::cluster();
     limited.desc.collisions = Collisions::SpeedLimited;
     let n = steps(paper.steps);
-    out.extend(rows(
+    out.extend(rows::<Ended>(
         "M5.2b speed-limited collisions",
         format!("{} (e = 1)", paper.name),
         &[("kinetic energy, relative change", |e| e.energy_change), ("clamps", |e| e.clamps)],
@@ -182,7 +169,7 @@ pub fn measure(share: f64, box_steps: u64, runs: usize) -> Vec<AdditionRow> {
     let mut without = scenes::water_pool();
     without.desc.contacts = false;
     let n = steps(with.steps);
-    out.extend(rows(
+    out.extend(rows::<Ended>(
         "M5.7 contacts",
         format!("{} (e = 0.5)", with.name),
         &[("mean speed at the end", |e| e.mean_speed), ("clamps per particle-step", |e| e.clamps_per_particle_step)],
@@ -194,7 +181,7 @@ pub fn measure(share: f64, box_steps: u64, runs: usize) -> Vec<AdditionRow> {
     // M5.7b: the same pool with contacts, without and with resting contact.
     let mut resting = scenes::water_pool();
     resting.desc.rest = true;
-    out.extend(rows(
+    out.extend(rows::<Ended>(
         "M5.7b resting contact",
         format!("{} (e = 0.5, contacts)", with.name),
         &[
@@ -211,7 +198,7 @@ pub fn measure(share: f64, box_steps: u64, runs: usize) -> Vec<AdditionRow> {
     for e in [0.0, 0.5] {
         let (off, on) = (pile(e, false), pile(e, true));
         let n = steps(off.steps);
-        out.extend(rows(
+        out.extend(rows::<Ended>(
             "M5.7b resting contact",
             format!("{} (e = {e}, contacts)", off.name),
             &[
@@ -226,7 +213,7 @@ pub fn measure(share: f64, box_steps: u64, runs: usize) -> Vec<AdditionRow> {
     }
 
     // M1b: the elastic box, unbiased rounding against energy-neutral.
-    out.extend(rows(
+    out.extend(rows::<Ended>(
         "M1b energy-neutral rounding",
         "elastic 8-bit box, 128² (e = 1)".into(),
         &[("kinetic energy, relative change", |e| e.energy_change)],
